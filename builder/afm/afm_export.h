@@ -1,0 +1,74 @@
+// Scene + FDPs (+ morph targets and rigids) -> AFM file (formats/afm.md).
+//
+// The scene's welded vertices become AFM render vertices: a vertex is split
+// once per distinct texture coordinate it carries (a UV seam), so a render
+// vertex has one position, normal, uv and colour. Positions are quantised to
+// int16 on one grid centred on the scene's bounding box; normals are computed
+// on the welded mesh (area-weighted, so seams do not show) and stored Q14.
+#pragma once
+
+#include <afm/format.h>
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/fdp.h"
+#include "core/scene.h"
+#include "core/status.h"
+
+namespace afmb {
+
+// A morph target as the builder computes it: displacements of welded vertices.
+struct MorphTarget {
+  afm_target_kind kind = AFM_TARGET_FAP;
+  int number = 0;          // FAP 3..68, viseme 1..14, expression 1..6
+  int32_t reference = 0;   // FAP units (63 for visemes and expressions); < 0: negative side
+  // Per part: #V x 3 displacement in model units, or an empty matrix when the
+  // part does not move.
+  std::vector<Eigen::MatrixXd> displacement;
+  bool normals = false;    // also store normal deltas
+};
+
+// A rigid transform (eyeball, jaw, head) in model units.
+struct RigidPart {
+  afm_rigid_kind kind = AFM_RIGID_HEAD;
+  Eigen::Vector3d pivot = Eigen::Vector3d::Zero();     // model units
+  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();  // rows: local x, y, z
+  std::vector<int> parts;                              // scene part indices
+  struct Control {
+    int fap = 0;
+    afm_dof dof = AFM_DOF_ROTATE_X;
+    double gain = 0;  // AU per FAP unit (rotations), model units per FAP unit (translations)
+  };
+  std::vector<Control> controls;
+};
+
+struct AfmContent {
+  const Scene *scene = nullptr;
+  const FdpSet *fdps = nullptr;  // bound to scene
+  Fapu fapu;
+  std::vector<MorphTarget> targets;
+  std::vector<RigidPart> rigids;
+  std::string generator = "afm toolkit";
+};
+
+// Where each welded scene vertex went in the AFM.
+struct RenderVertices {
+  std::vector<int> first;   // per part: its first render vertex
+  // Per part, per welded vertex: the render vertices carrying it (>= 1 unless
+  // the vertex is in no triangle and has no texcoord, then exactly 1).
+  std::vector<std::vector<std::vector<uint32_t>>> copies;
+  size_t count = 0;         // total render vertices
+};
+
+RenderVertices split_render_vertices(const Scene &scene);
+
+// Encodes the content; `profile` AFM_PROFILE_DRACO uses the Draco codec.
+Expected<std::vector<uint8_t>> encode_afm(const AfmContent &content, afm_profile profile);
+
+// encode_afm, then an atomic write.
+Status write_afm(const std::string &path, const AfmContent &content, afm_profile profile);
+
+}  // namespace afmb

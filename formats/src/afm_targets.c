@@ -1,0 +1,183 @@
+/* MTGT chunk: sparse quantised morph targets (formats/afm.md). */
+#include <string.h>
+
+#include "afm_internal.h"
+
+static int number_valid(uint8_t kind, uint8_t number) {
+  switch (kind) {
+    case AFM_TARGET_FAP: return number >= 3 && number <= 68;
+    case AFM_TARGET_VISEME: return number >= 1 && number <= 14;
+    case AFM_TARGET_EXPRESSION: return number >= 1 && number <= 6;
+    default: return 0;
+  }
+}
+
+static const char *kind_text(uint8_t kind) {
+  switch (kind) {
+    case AFM_TARGET_FAP: return "FAP";
+    case AFM_TARGET_VISEME: return "viseme";
+    case AFM_TARGET_EXPRESSION: return "expression";
+    default: return "?";
+  }
+}
+
+afm_result afm_targets_decode_at(const uint8_t *raw, size_t size, uint64_t file_offset,
+                                 uint32_t vertex_count, afm_arena *arena, uint32_t *count_out,
+                                 afm_target **targets_out, afm_diag *diag) {
+  afm_reader r;
+  afm_target *targets;
+  uint32_t count, i, j;
+
+  afm_reader_init(&r, raw, size, file_offset, AFM_CHUNK_MTGT, diag);
+  count = afm_read_u32(&r, "target_count");
+  if (r.error != AFM_OK) return r.error;
+  if (count > afm_remaining(&r) / 16)
+    return afm_fail(&r, AFM_ERR_TRUNCATED, "target_count %lu cannot fit in %lu bytes",
+                    (unsigned long)count, (unsigned long)afm_remaining(&r));
+  targets = (afm_target *)afm_arena_take(arena, afm_mul_size(count, sizeof *targets));
+  for (i = 0; i < count; ++i) {
+    afm_target t;
+    afm_run *runs;
+    uint32_t k, end = 0;
+    uint64_t total = 0;
+    memset(&t, 0, sizeof t);
+    t.kind = afm_read_u8(&r, "target.kind");
+    t.number = afm_read_u8(&r, "target.number");
+    t.flags = afm_read_u8(&r, "target.flags");
+    if (afm_read_u8(&r, "target.reserved") != 0 && r.error == AFM_OK)
+      return afm_fail(&r, AFM_ERR_RANGE, "target %lu: reserved byte not zero", (unsigned long)i);
+    t.reference = afm_read_i32(&r, "target.reference");
+    t.run_count = afm_read_u32(&r, "target.run_count");
+    t.delta_count = afm_read_u32(&r, "target.delta_count");
+    if (r.error != AFM_OK) return r.error;
+    if (!number_valid(t.kind, t.number))
+      return afm_fail(&r, AFM_ERR_RANGE, "target %lu: %s %u is not a valid target",
+                      (unsigned long)i, kind_text(t.kind), (unsigned)t.number);
+    if (t.flags & ~(uint8_t)AFM_TARGET_NORMALS)
+      return afm_fail(&r, AFM_ERR_RANGE, "target %lu: unknown flags 0x%x", (unsigned long)i,
+                      (unsigned)t.flags);
+    if (t.reference == 0 || (t.kind != AFM_TARGET_FAP && t.reference < 0))
+      return afm_fail(&r, AFM_ERR_RANGE, "target %lu (%s %u): reference value %ld",
+                      (unsigned long)i, kind_text(t.kind), (unsigned)t.number, (long)t.reference);
+    for (j = 0; targets && j < i; ++j)
+      if (targets[j].kind == t.kind && targets[j].number == t.number &&
+          (targets[j].reference > 0) == (t.reference > 0))
+        return afm_fail(&r, AFM_ERR_RANGE, "target %lu: %s %u (%s side) appears twice",
+                        (unsigned long)i, kind_text(t.kind), (unsigned)t.number,
+                        t.reference > 0 ? "positive" : "negative");
+    if (t.run_count > afm_remaining(&r) / 8 || t.delta_count > afm_remaining(&r) / 6)
+      return afm_fail(&r, AFM_ERR_TRUNCATED, "target %lu: %lu runs and %lu deltas cannot fit",
+                      (unsigned long)i, (unsigned long)t.run_count,
+                      (unsigned long)t.delta_count);
+    runs = (afm_run *)afm_arena_take(arena, afm_mul_size(t.run_count, sizeof *runs));
+    for (k = 0; k < t.run_count; ++k) {
+      afm_run run;
+      run.start = afm_read_u32(&r, "run.start");
+      run.length = afm_read_u32(&r, "run.length");
+      if (r.error != AFM_OK) return r.error;
+      if (run.length == 0 || (k > 0 && run.start < end) || run.start > vertex_count ||
+          run.length > vertex_count - run.start)
+        return afm_fail(&r, AFM_ERR_RANGE,
+                        "target %lu (%s %u): run %lu [%lu, +%lu) is empty, overlaps the "
+                        "previous run or passes vertex_count %lu",
+                        (unsigned long)i, kind_text(t.kind), (unsigned)t.number,
+                        (unsigned long)k, (unsigned long)run.start, (unsigned long)run.length,
+                        (unsigned long)vertex_count);
+      end = run.start + run.length;
+      total += run.length;
+      if (runs) runs[k] = run;
+    }
+    if (total != t.delta_count)
+      return afm_fail(&r, AFM_ERR_RANGE, "target %lu: runs cover %lu vertices, delta_count is %lu",
+                      (unsigned long)i, (unsigned long)total, (unsigned long)t.delta_count);
+    t.runs = runs;
+    t.dx = afm_read_i16_array(&r, arena, t.delta_count, "deltas.x");
+    t.dy = afm_read_i16_array(&r, arena, t.delta_count, "deltas.y");
+    t.dz = afm_read_i16_array(&r, arena, t.delta_count, "deltas.z");
+    if (t.flags & AFM_TARGET_NORMALS) {
+      t.nx = afm_read_i16_array(&r, arena, t.delta_count, "normal_deltas.x");
+      t.ny = afm_read_i16_array(&r, arena, t.delta_count, "normal_deltas.y");
+      t.nz = afm_read_i16_array(&r, arena, t.delta_count, "normal_deltas.z");
+    }
+    if (r.error != AFM_OK) return r.error;
+    if (targets) targets[i] = t;
+  }
+  if (afm_remaining(&r) != 0)
+    return afm_fail(&r, AFM_ERR_TRAILING_BYTES, "%lu bytes after the last target",
+                    (unsigned long)afm_remaining(&r));
+  *count_out = count;
+  *targets_out = targets;
+  return AFM_OK;
+}
+
+afm_result afm_targets_decode(const uint8_t *raw, size_t size, uint32_t vertex_count,
+                              void *buffer, size_t buffer_size, size_t *bytes,
+                              uint32_t *target_count, afm_target **targets, afm_diag *diag) {
+  afm_arena arena;
+  uint32_t n = 0;
+  afm_target *t = NULL;
+  afm_result res;
+  if (!raw || (!buffer && buffer_size)) return AFM_ERR_ARGUMENT;
+  arena.base = (uint8_t *)buffer;
+  arena.size = buffer_size;
+  arena.used = 0;
+  res = afm_targets_decode_at(raw, size, 0, vertex_count, &arena, &n, &t, diag);
+  if (bytes) *bytes = arena.used;
+  if (target_count) *target_count = n;
+  if (targets) *targets = t;
+  if (res == AFM_OK && buffer && arena.used > buffer_size) return AFM_ERR_BUFFER_TOO_SMALL;
+  return res;
+}
+
+afm_result afm_targets_encode_to(const afm_target *targets, uint32_t count, afm_writer *w) {
+  uint32_t i, k;
+  if (count && !targets) return AFM_ERR_ARGUMENT;
+  afm_write_u32(w, count);
+  for (i = 0; i < count; ++i) {
+    const afm_target *t = &targets[i];
+    size_t n = t->delta_count;
+    if ((t->run_count && !t->runs) || (n && (!t->dx || !t->dy || !t->dz)) ||
+        ((t->flags & AFM_TARGET_NORMALS) && n && (!t->nx || !t->ny || !t->nz)))
+      return AFM_ERR_ARGUMENT;
+    afm_write_u8(w, t->kind);
+    afm_write_u8(w, t->number);
+    afm_write_u8(w, t->flags);
+    afm_write_u8(w, 0);
+    afm_write_i32(w, t->reference);
+    afm_write_u32(w, t->run_count);
+    afm_write_u32(w, t->delta_count);
+    for (k = 0; k < t->run_count; ++k) {
+      afm_write_u32(w, t->runs[k].start);
+      afm_write_u32(w, t->runs[k].length);
+    }
+    afm_write_i16_array(w, t->dx, n);
+    afm_write_i16_array(w, t->dy, n);
+    afm_write_i16_array(w, t->dz, n);
+    if (t->flags & AFM_TARGET_NORMALS) {
+      afm_write_i16_array(w, t->nx, n);
+      afm_write_i16_array(w, t->ny, n);
+      afm_write_i16_array(w, t->nz, n);
+    }
+  }
+  return w->overflow ? AFM_ERR_BUFFER_TOO_SMALL : AFM_OK;
+}
+
+afm_result afm_targets_encoded_size(const afm_target *targets, uint32_t count, size_t *size) {
+  afm_writer w = {NULL, 0, 0, 0};
+  afm_result r;
+  if (!size) return AFM_ERR_ARGUMENT;
+  r = afm_targets_encode_to(targets, count, &w);
+  *size = w.pos;
+  return r;
+}
+
+afm_result afm_targets_encode(const afm_target *targets, uint32_t count, uint8_t *out,
+                              size_t size) {
+  afm_writer w;
+  if (!out) return AFM_ERR_ARGUMENT;
+  w.data = out;
+  w.size = size;
+  w.pos = 0;
+  w.overflow = 0;
+  return afm_targets_encode_to(targets, count, &w);
+}

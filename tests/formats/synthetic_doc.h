@@ -1,0 +1,54 @@
+// A synthetic AFM document for format tests: a grid "skin" wrapped on an
+// ellipsoid (an open patch, so it has boundaries), a small closed "eye"
+// sphere, morph targets from analytic displacement fields, and rigids.
+#pragma once
+
+#include <afm/format.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace afmtest {
+
+struct SyntheticDoc {
+  // Storage the afm_doc points into.
+  std::vector<afm_part> parts;
+  std::vector<int16_t> px, py, pz, nx, ny, nz;
+  std::vector<uint16_t> u, v;
+  std::vector<uint8_t> rgba;
+  std::vector<uint32_t> tris;
+  std::vector<afm_fdp_point> fdps;
+  struct Target {
+    std::vector<afm_run> runs;
+    std::vector<int16_t> dx, dy, dz, nx, ny, nz;
+  };
+  std::vector<Target> target_data;
+  std::vector<afm_target> targets;
+  std::vector<uint16_t> rigid_parts;
+  std::vector<afm_control> controls;
+  std::vector<afm_rigid> rigids;
+  afm_doc doc{};
+};
+
+struct SyntheticOptions {
+  int rows = 24, cols = 32;   // skin grid
+  bool normals = true;
+  bool texcoords = true;
+  bool colors = true;
+  bool normal_deltas = true;
+  bool shuffle_triangles = false;  // write triangles in a non-canonical order
+  bool loose_vertex = false;       // drop the skin's triangles using vertex 7 (unreferenced)
+};
+
+// Fills `s` and returns &s.doc (valid while `s` lives and is not moved).
+const afm_doc *make_synthetic_doc(SyntheticDoc &s, const SyntheticOptions &o = {});
+
+// Writes with the raw or draco profile; fails the current test on error.
+std::vector<uint8_t> write_doc(const afm_doc &doc, afm_profile profile);
+
+// Deep comparison of two documents (every field and array); "" when equal,
+// else a description of the first difference.
+std::string compare_docs(const afm_doc &a, const afm_doc &b);
+
+}  // namespace afmtest

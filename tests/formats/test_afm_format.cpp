@@ -1,0 +1,324 @@
+// AFM container and codec: round trips, profiles, damage and bad input.
+#include <afm/draco.h>
+#include <afm/format.h>
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <memory>
+#include <random>
+
+#include "synthetic_doc.h"
+
+using afmtest::compare_docs;
+using afmtest::make_synthetic_doc;
+using afmtest::SyntheticDoc;
+using afmtest::write_doc;
+
+namespace {
+
+struct Freer {
+  void operator()(afm_doc *d) const { afm_free(nullptr, d); }
+};
+using DocPtr = std::unique_ptr<afm_doc, Freer>;
+
+afm_result read(const std::vector<uint8_t> &bytes, DocPtr *doc, afm_diag *diag = nullptr,
+                const afm_chunk_codec *draco = afm_draco_codec()) {
+  afm_read_options ro{};
+  ro.draco = draco;
+  ro.diag = diag;
+  afm_doc *d = nullptr;
+  afm_result r = afm_doc_read_alloc(bytes.data(), bytes.size(), &ro, nullptr, &d);
+  doc->reset(d);
+  return r;
+}
+
+uint32_t le32(const uint8_t *p) { return p[0] | p[1] << 8 | p[2] << 16 | uint32_t(p[3]) << 24; }
+void put32(uint8_t *p, uint32_t v) {
+  for (int i = 0; i < 4; ++i) p[i] = uint8_t(v >> (8 * i));
+}
+
+// Re-seals the header CRC after a test edits the header or table.
+void reseal_header(std::vector<uint8_t> &f) {
+  uint32_t count = le32(&f[12]);
+  size_t end = 16 + 20 * size_t(count);
+  put32(&f[end], afm_crc32(f.data(), end));
+}
+
+// Re-seals chunk i's CRC after a test edits its payload.
+void reseal_chunk(std::vector<uint8_t> &f, uint32_t i) {
+  uint8_t *e = &f[16 + 20 * size_t(i)];
+  put32(e + 16, afm_crc32(&f[le32(e + 8)], le32(e + 12)));
+  reseal_header(f);
+}
+
+// Encoding (0 raw, 1 draco) of the chunk of this kind.
+int chunk_encoding(const std::vector<uint8_t> &f, uint32_t kind) {
+  afm_container c;
+  if (afm_container_open(f.data(), f.size(), &c, nullptr) != AFM_OK) return -1;
+  for (uint32_t i = 0; i < c.chunk_count; ++i) {
+    afm_chunk_info ch;
+    afm_container_chunk(&c, i, &ch);
+    if (ch.kind == kind) return ch.encoding;
+  }
+  return -1;
+}
+
+}  // namespace
+
+TEST(AfmFormat, RawRoundTripKeepsEveryField) {
+  SyntheticDoc s;
+  const afm_doc *src = make_synthetic_doc(s);
+  std::vector<uint8_t> bytes = write_doc(*src, AFM_PROFILE_RAW);
+  DocPtr doc;
+  afm_diag diag{};
+  ASSERT_EQ(read(bytes, &doc, &diag), AFM_OK) << diag.message;
+  EXPECT_EQ(compare_docs(*src, *doc), "");
+  EXPECT_EQ(doc->skipped_chunks, 0u);
+  // Writing what we read gives the same bytes: the encoding is canonical.
+  EXPECT_EQ(write_doc(*doc, AFM_PROFILE_RAW), bytes);
+}
+
+TEST(AfmFormat, BufferApiMatchesAllocatingApi) {
+  SyntheticDoc s;
+  std::vector<uint8_t> bytes = write_doc(*make_synthetic_doc(s), AFM_PROFILE_RAW);
+  size_t need = 0;
+  ASSERT_EQ(afm_doc_measure(bytes.data(), bytes.size(), nullptr, &need), AFM_OK);
+  std::vector<uint64_t> buf(need / 8 + 1);
+  afm_doc *doc = nullptr;
+  EXPECT_EQ(afm_doc_read(bytes.data(), bytes.size(), nullptr, buf.data(), need - 8, &doc),
+            AFM_ERR_BUFFER_TOO_SMALL);
+  ASSERT_EQ(afm_doc_read(bytes.data(), bytes.size(), nullptr, buf.data(), need, &doc), AFM_OK);
+  EXPECT_EQ(compare_docs(s.doc, *doc), "");
+  // A raw file needs no codec at all.
+  afm_read_options ro{};
+  EXPECT_EQ(afm_doc_measure(bytes.data(), bytes.size(), &ro, &need), AFM_OK);
+}
+
+TEST(AfmFormat, WriterCanonicalisesTriangleOrder) {
+  SyntheticDoc canonical, shuffled;
+  afmtest::SyntheticOptions o;
+  make_synthetic_doc(canonical);
+  o.shuffle_triangles = true;
+  const afm_doc *src = make_synthetic_doc(shuffled, o);
+  ASSERT_NE(shuffled.tris, canonical.tris);
+  DocPtr doc;
+  ASSERT_EQ(read(write_doc(*src, AFM_PROFILE_RAW), &doc), AFM_OK);
+  EXPECT_EQ(compare_docs(canonical.doc, *doc), "");
+}
+
+TEST(AfmFormat, RawAndDracoConvertExactly) {
+  for (int variant = 0; variant < 3; ++variant) {
+    const bool attrs = variant != 1;
+    SyntheticDoc s;
+    afmtest::SyntheticOptions o;
+    o.normals = o.texcoords = o.colors = o.normal_deltas = attrs;
+    o.loose_vertex = variant == 2;  // edgebreaker drops it: it travels beside the stream
+    o.rows = 60, o.cols = 80;
+    const afm_doc *src = make_synthetic_doc(s, o);
+    std::vector<uint8_t> raw = write_doc(*src, AFM_PROFILE_RAW);
+    std::vector<uint8_t> draco = write_doc(*src, AFM_PROFILE_DRACO);
+    EXPECT_EQ(chunk_encoding(draco, AFM_CHUNK_GEOM), AFM_ENCODING_DRACO) << "variant " << variant;
+    EXPECT_LT(draco.size(), raw.size());
+    DocPtr from_draco;
+    afm_diag diag{};
+    ASSERT_EQ(read(draco, &from_draco, &diag), AFM_OK) << diag.message;
+    EXPECT_EQ(compare_docs(*src, *from_draco), "");
+
+    // draco -> raw gives the raw file byte for byte; raw -> draco -> raw too.
+    uint8_t *out = nullptr;
+    size_t n = 0;
+    ASSERT_EQ(afm_transcode(draco.data(), draco.size(), AFM_PROFILE_RAW, afm_draco_codec(), nullptr,
+                            &out, &n, &diag),
+              AFM_OK)
+        << diag.message;
+    EXPECT_EQ(std::vector<uint8_t>(out, out + n), raw);
+    afm_free(nullptr, out);
+    ASSERT_EQ(afm_transcode(raw.data(), raw.size(), AFM_PROFILE_DRACO, afm_draco_codec(), nullptr,
+                            &out, &n, &diag),
+              AFM_OK);
+    EXPECT_EQ(std::vector<uint8_t>(out, out + n), draco);
+    afm_free(nullptr, out);
+  }
+}
+
+TEST(AfmFormat, DracoFileWithoutCodecSaysSo) {
+  SyntheticDoc s;
+  afmtest::SyntheticOptions o;
+  o.rows = 60, o.cols = 80;
+  std::vector<uint8_t> draco = write_doc(*make_synthetic_doc(s, o), AFM_PROFILE_DRACO);
+  DocPtr doc;
+  afm_diag diag{};
+  EXPECT_EQ(read(draco, &doc, &diag, nullptr), AFM_ERR_NEED_DRACO);
+  EXPECT_NE(std::string(diag.message).find("afm-pack --raw"), std::string::npos) << diag.message;
+}
+
+TEST(AfmFormat, EveryPrefixIsRejected) {
+  for (afm_profile profile : {AFM_PROFILE_RAW, AFM_PROFILE_DRACO}) {
+    SyntheticDoc s;
+    afmtest::SyntheticOptions o;
+    o.rows = 8, o.cols = 10;
+    std::vector<uint8_t> bytes = write_doc(*make_synthetic_doc(s, o), profile);
+    for (size_t n = 0; n < bytes.size(); ++n) {
+      std::vector<uint8_t> prefix(bytes.begin(), bytes.begin() + n);
+      DocPtr doc;
+      afm_result r = read(prefix, &doc);
+      ASSERT_NE(r, AFM_OK) << "prefix of " << n << " bytes accepted";
+      ASSERT_EQ(doc, nullptr);
+    }
+  }
+}
+
+TEST(AfmFormat, CorruptionIsDetected) {
+  SyntheticDoc s;
+  std::vector<uint8_t> good = write_doc(*make_synthetic_doc(s), AFM_PROFILE_RAW);
+  afm_container c;
+  ASSERT_EQ(afm_container_open(good.data(), good.size(), &c, nullptr), AFM_OK);
+  for (uint32_t i = 0; i < c.chunk_count; ++i) {
+    afm_chunk_info ch;
+    afm_container_chunk(&c, i, &ch);
+    std::vector<uint8_t> bad = good;
+    bad[ch.offset + ch.length / 2] ^= 0x10;
+    DocPtr doc;
+    afm_diag diag{};
+    EXPECT_EQ(read(bad, &doc, &diag), AFM_ERR_CHUNK_CRC) << "chunk " << i;
+    EXPECT_EQ(diag.chunk, ch.kind);
+  }
+  std::vector<uint8_t> bad = good;
+  bad[16 + 4] ^= 1;  // a chunk's flags in the table
+  DocPtr doc;
+  EXPECT_EQ(read(bad, &doc), AFM_ERR_HEADER_CRC);
+  bad = good;
+  bad[1] = 'B';
+  EXPECT_EQ(read(bad, &doc), AFM_ERR_MAGIC);
+  bad = good;
+  bad[8] = 2;  // major version 2
+  reseal_header(bad);
+  EXPECT_EQ(read(bad, &doc), AFM_ERR_VERSION);
+  bad = good;
+  bad.insert(bad.end(), {0, 0, 0, 0});
+  EXPECT_EQ(read(bad, &doc), AFM_ERR_TRAILING_BYTES);
+}
+
+// Inserts a chunk of `kind` with `flags` before the first one.
+std::vector<uint8_t> with_extra_chunk(const std::vector<uint8_t> &good, uint32_t kind,
+                                      uint16_t flags, uint16_t encoding) {
+  afm_container c;
+  EXPECT_EQ(afm_container_open(good.data(), good.size(), &c, nullptr), AFM_OK);
+  std::vector<afm_chunk_out> chunks;
+  static const uint8_t payload[8] = {1, 2, 3, 4, 5, 6, 7, 8};
+  chunks.push_back({kind, flags, encoding, payload, sizeof payload});
+  for (uint32_t i = 0; i < c.chunk_count; ++i) {
+    afm_chunk_info ch;
+    afm_container_chunk(&c, i, &ch);
+    chunks.push_back({ch.kind, ch.flags, ch.encoding, ch.data, ch.length});
+  }
+  size_t n = 0;
+  EXPECT_EQ(afm_container_size(chunks.data(), uint32_t(chunks.size()), &n), AFM_OK);
+  std::vector<uint8_t> out(n);
+  EXPECT_EQ(afm_container_write(chunks.data(), uint32_t(chunks.size()), out.data(), n), AFM_OK);
+  return out;
+}
+
+TEST(AfmFormat, UnknownOptionalChunkIsSkippedRequiredRefused) {
+  SyntheticDoc s;
+  const afm_doc *src = make_synthetic_doc(s);
+  std::vector<uint8_t> good = write_doc(*src, AFM_PROFILE_RAW);
+  const uint32_t xtra = AFM_FOURCC('X', 'T', 'R', 'A');
+  DocPtr doc;
+  afm_diag diag{};
+  ASSERT_EQ(read(with_extra_chunk(good, xtra, 0, AFM_ENCODING_RAW), &doc, &diag), AFM_OK)
+      << diag.message;
+  EXPECT_EQ(doc->skipped_chunks, 1u);
+  EXPECT_EQ(compare_docs(*src, *doc), "");
+  diag = afm_diag{};
+  EXPECT_EQ(read(with_extra_chunk(good, xtra, AFM_CHUNK_REQUIRED, AFM_ENCODING_RAW), &doc, &diag),
+            AFM_ERR_UNKNOWN_REQUIRED);
+  EXPECT_NE(std::string(diag.message).find("XTRA"), std::string::npos) << diag.message;
+  // A known kind with an unknown encoding behaves the same way.
+  EXPECT_EQ(read(with_extra_chunk(good, AFM_CHUNK_RIGD, AFM_CHUNK_REQUIRED, 7), &doc),
+            AFM_ERR_UNKNOWN_REQUIRED);
+  EXPECT_EQ(read(with_extra_chunk(good, AFM_CHUNK_GEOM, AFM_CHUNK_REQUIRED, AFM_ENCODING_RAW), &doc),
+            AFM_ERR_DUPLICATE_CHUNK);
+  // Transcoding keeps the unknown chunk.
+  std::vector<uint8_t> extra = with_extra_chunk(good, xtra, 0, AFM_ENCODING_RAW);
+  uint8_t *out = nullptr;
+  size_t n = 0;
+  ASSERT_EQ(afm_transcode(extra.data(), extra.size(), AFM_PROFILE_RAW, afm_draco_codec(), nullptr,
+                          &out, &n, nullptr),
+            AFM_OK);
+  EXPECT_EQ(std::vector<uint8_t>(out, out + n), extra);
+  afm_free(nullptr, out);
+}
+
+TEST(AfmFormat, WriterRefusesInvalidDocuments) {
+  struct Case {
+    const char *what;
+    void (*spoil)(SyntheticDoc &);
+    const char *message;
+  };
+  const Case cases[] = {
+      {"triangle outside its part", [](SyntheticDoc &s) { s.tris[5] = s.parts[0].vertex_count + 3; },
+       "outside the part"},
+      {"repeated index", [](SyntheticDoc &s) { s.tris[1] = s.tris[0]; }, "repeated index"},
+      {"duplicate target", [](SyntheticDoc &s) { s.targets[1].number = 3; s.targets[1].reference = 7; },
+       "appears twice"},
+      {"run past the end",
+       [](SyntheticDoc &s) { s.target_data[0].runs.back().start = s.doc.geometry.vertex_count - 1; },
+       "passes vertex_count"},
+      {"FDP vertex out of range", [](SyntheticDoc &s) { s.fdps[0].vertex = 1u << 30; }, "vertex"},
+      {"bad FAP number", [](SyntheticDoc &s) { s.targets[0].number = 2; }, "not a valid target"},
+      {"rigid part out of range", [](SyntheticDoc &s) { s.rigid_parts[0] = 9; }, "part_count"},
+      {"zero reference", [](SyntheticDoc &s) { s.targets[2].reference = 0; }, "reference"},
+      {"duplicate part name", [](SyntheticDoc &s) { s.parts[1].name = "skin"; }, "used twice"},
+  };
+  for (const Case &c : cases) {
+    SyntheticDoc s;
+    make_synthetic_doc(s);
+    c.spoil(s);
+    afm_write_options wo{};
+    afm_diag diag{};
+    wo.diag = &diag;
+    uint8_t *out = nullptr;
+    size_t n = 0;
+    afm_result r = afm_doc_write(&s.doc, &wo, &out, &n);
+    EXPECT_NE(r, AFM_OK) << c.what;
+    EXPECT_EQ(out, nullptr) << c.what;
+    EXPECT_NE(std::string(diag.message).find(c.message), std::string::npos)
+        << c.what << ": " << diag.message;
+  }
+}
+
+// Damage inside Draco streams with valid CRCs: an error or a valid file,
+// never a crash (run under ASan in CI).
+TEST(AfmFormat, DamagedDracoStreamsFailCleanly) {
+  SyntheticDoc s;
+  afmtest::SyntheticOptions o;
+  o.rows = 30, o.cols = 40;
+  std::vector<uint8_t> good = write_doc(*make_synthetic_doc(s, o), AFM_PROFILE_DRACO);
+  afm_container c;
+  ASSERT_EQ(afm_container_open(good.data(), good.size(), &c, nullptr), AFM_OK);
+  std::mt19937 rng(1234);
+  int errors = 0, trials = 0;
+  for (uint32_t i = 0; i < c.chunk_count; ++i) {
+    afm_chunk_info ch;
+    afm_container_chunk(&c, i, &ch);
+    if (ch.encoding != AFM_ENCODING_DRACO) continue;
+    for (int t = 0; t < 150; ++t) {
+      std::vector<uint8_t> bad = good;
+      size_t at = ch.offset + rng() % ch.length;
+      bad[at] ^= uint8_t(1 + rng() % 255);
+      reseal_chunk(bad, i);
+      DocPtr doc;
+      if (read(bad, &doc) != AFM_OK) ++errors;
+      ++trials;
+    }
+  }
+  EXPECT_GT(trials, 0);
+  EXPECT_GT(errors, trials / 4);  // most damage is caught, and none crashes
+}
+
+TEST(AfmFormat, Crc32MatchesTheStandardCheckValue) {
+  const char *check = "123456789";  // CRC-32/ISO-HDLC check value
+  EXPECT_EQ(afm_crc32(reinterpret_cast<const uint8_t *>(check), 9), 0xCBF43926u);
+  EXPECT_EQ(afm_crc32(nullptr, 0), 0u);
+}

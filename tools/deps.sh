@@ -1,0 +1,40 @@
+#!/bin/sh
+# Installs the Debian packages the toolkit needs, when they are missing.
+# Prints one line when everything is there already.
+set -eu
+
+PACKAGES="
+  make g++ gcc pkg-config
+  libeigen3-dev libopenmesh-dev libdraco-dev
+  libosmesa6-dev libglfw3-dev libpng-dev
+  libgtest-dev
+"
+
+missing=""
+for p in $PACKAGES; do
+  status=$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null || true)
+  case "$status" in
+    "install ok installed") ;;
+    *) missing="$missing $p" ;;
+  esac
+done
+
+if [ -z "$missing" ]; then
+  echo "deps: all packages present"
+  exit 0
+fi
+
+echo "deps: installing$missing"
+if [ "$(id -u)" -eq 0 ]; then
+  SUDO=""
+elif command -v sudo >/dev/null 2>&1; then
+  SUDO="sudo"
+else
+  echo "deps: need root (or sudo) to install:$missing" >&2
+  exit 1
+fi
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+# shellcheck disable=SC2086
+$SUDO apt-get install -y -qq --no-install-recommends $missing >/dev/null
+echo "deps: done"
