@@ -24,9 +24,15 @@ namespace afmb {
 // Polygons are fan-triangulated from their first vertex. Part kinds are
 // guessed from names (guess_part_kind). Errors name the file and, where the
 // format has lines, the line: a missing file, an unknown extension, an index
-// out of range, a face repeating a vertex, a face OpenMesh drops or has to
-// split off because it is not manifold (checked by comparing OpenMesh's face
-// count with the file's). OpenMesh's own messages are captured into the error
+// out of range, a face repeating a vertex, a face OpenMesh drops (found by
+// comparing OpenMesh's face count with the file's).
+// Faces OpenMesh can hold only by splitting them off onto copies of their
+// vertices (inconsistent orientation, a third face on an edge, two fans at a
+// vertex): in OBJ they are kept as written, on the file's vertices, and left
+// for check_skin() to judge (the Candide-3 OBJ has 29 edges where neighbouring
+// triangles wind opposite ways); in
+// PLY/OFF/STL, where the file's indices are not at hand, they are an error
+// naming the face. OpenMesh's own messages are captured into the error
 // instead of going to stderr (its streams are process-wide: do not read
 // meshes from two threads at once).
 Expected<Scene> read_scene(const std::string &path);

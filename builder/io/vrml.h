@@ -1,13 +1,38 @@
 // VRML97 scenes of named IndexedFaceSet parts: Xface, visage and Song models.
 //
-// Reads Transform / Group / Shape / IndexedFaceSet / Coordinate /
-// TextureCoordinate / Appearance / Material / ImageTexture, DEF and USE, and
-// nested Transforms (translation, rotation, scale, scaleOrientation,
-// center), applied to the points. Each IndexedFaceSet becomes a part named
-// after the nearest DEF'd Transform (else its own DEF, else "shape<N>"), with
-// aliases: its own DEF name and "<file name>_<N>" (XfaceEd's name for
-// un-DEF'd meshes). Polygons are fan-triangulated; `ccw FALSE` flips them.
-// Unknown nodes are skipped whole. Errors name the file and line.
+// Reads Transform / Group / Collision / Anchor / Billboard / Switch (the
+// chosen child) / LOD (the first level) / Shape / IndexedFaceSet /
+// Coordinate / TextureCoordinate / Color / Appearance / Material /
+// ImageTexture, DEF and USE, and nested Transforms (translation, rotation,
+// scale, scaleOrientation, center: P' = T C R SR S -SR -C P), applied to the
+// points. Every other node (PROTO instances included) is skipped whole, as
+// are PROTO, EXTERNPROTO and ROUTE statements and unknown fields. The file
+// must start with "#VRML V2.0".
+//
+// Each IndexedFaceSet instance becomes a part. Its name: the DEF of the
+// innermost DEF'd grouping node that holds no other mesh (Song:
+// "song_head"), else the IndexedFaceSet's DEF, else the Shape's, else
+// "shape<N>" (N = the part's index); a name already taken gets "_2", "_3".
+// Aliases: the IndexedFaceSet's DEF ("song_head-FACES", the name XfaceEd FDP
+// files use) and the Shape's DEF when they differ from the name, and, for an
+// IndexedFaceSet without DEF, "<file name>_<N>" with N counting such
+// IndexedFaceSets from 0 in file order (XfaceEd's name for them, e.g.
+// "alice.wrl_3"). The kind is guessed from the names (guess_part_kind).
+//
+// Geometry: every Coordinate point is kept, used or not, so FDP vertex
+// indices stay valid. Polygons (-1 terminated; a missing final -1 is
+// accepted) are fan-triangulated from their first corner; `ccw FALSE`, or a
+// mirroring transform, reverses them so triangles stay counter-clockwise
+// seen from outside. texCoordIndex (or coordIndex when it is absent) gives
+// FTC. Colours: colorPerVertex TRUE only, colour i for point i or per corner
+// through colorIndex (a point takes its first corner's colour); per-face
+// colours are ignored. Normals are ignored.
+//
+// Errors name the file and line: "song.WRL:1733: coordIndex 9999 out of range
+// (2916 points)", a bracket never closed (the line where it opened), USE of
+// an undefined name, a malformed number, a polygon of fewer than 3 corners,
+// texCoordIndex polygons that do not match coordIndex, an Inline (its
+// geometry would be missing). A file without any IndexedFaceSet is an error.
 #pragma once
 
 #include <string>
@@ -24,7 +49,11 @@ Expected<Scene> parse_vrml(std::string_view text, const std::string &source_name
 
 // Writes one DEF'd Transform + Shape + IndexedFaceSet per part, with Material,
 // ImageTexture and TextureCoordinate where the part has them, and per-vertex
-// Color when it has C. Atomic.
+// Color when it has C; numbers in their shortest exact form, so read_vrml()
+// gives back the same doubles. The Transform is DEF'd with the part's name,
+// the IndexedFaceSet with its first alias that is a legal VRML name (else
+// "<name>-FACES"); characters VRML forbids in names become '_' and repeated
+// names get "_2". Kinds and further aliases are not written. Atomic.
 Status write_vrml(const Scene &scene, const std::string &path);
 
 }  // namespace afmb

@@ -206,9 +206,11 @@ int main(int argc, char **argv) {
     r = afm_doc_read_alloc(data, size, &ro, NULL, &doc);
   }
   if (r != AFM_OK) {
-    fprintf(stderr, "afm-info: %s: %s (%s, at byte %lu)\n", path,
-            diag.message[0] ? diag.message : afm_result_string(r), afm_result_string(r),
-            (unsigned long)diag.offset);
+    if (diag.message[0])
+      fprintf(stderr, "afm-info: %s: %s (at byte %lu)\n", path, diag.message,
+              (unsigned long)diag.offset);
+    else
+      fprintf(stderr, "afm-info: %s: %s\n", path, afm_result_string(r));
     free(data);
     return 1;
   }

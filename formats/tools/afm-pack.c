@@ -68,8 +68,11 @@ int main(int argc, char **argv) {
                     &packed_size, &diag);
   free(data);
   if (r != AFM_OK) {
-    fprintf(stderr, "afm-pack: %s: %s (%s)\n", in,
-            diag.message[0] ? diag.message : afm_result_string(r), afm_result_string(r));
+    if (diag.message[0])
+      fprintf(stderr, "afm-pack: %s: %s (at byte %lu)\n", in, diag.message,
+              (unsigned long)diag.offset);
+    else
+      fprintf(stderr, "afm-pack: %s: %s\n", in, afm_result_string(r));
     return 1;
   }
   r = afm_file_write_atomic(out, packed, packed_size);

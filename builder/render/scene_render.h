@@ -1,0 +1,42 @@
+// Pictures of a scene: its parts as shaded meshes, its FDPs as dots.
+//
+// A thin C++ layer over afm/render.h (ports/osmesa) for tools and tests:
+// converts Scene parts to render meshes (per-vertex colours where a part has
+// them, else its diffuse colour), lays several views side by side and
+// writes one PNG.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/fdp.h"
+#include "core/scene.h"
+#include "core/status.h"
+
+namespace afmb {
+
+struct SceneView {
+  float yaw_deg = 0;    // positive: the camera moves toward the face's left (+x)
+  float pitch_deg = 0;  // positive: the camera moves up and looks down
+};
+
+struct SceneRenderOptions {
+  int width = 600, height = 720;  // of each view
+  std::vector<SceneView> views{SceneView{}, SceneView{40.0f, 5.0f}};
+  bool wireframe = false;       // triangle edges over the skin
+  float fdp_dot_pixels = 7.0f;  // size of FDP dots when FDPs are given; 0 draws none
+  // Frame only the face (the FDPs' box without the ears, skull top and
+  // spine) instead of every part. Needs FDPs.
+  bool face_closeup = false;
+};
+
+// Renders each view into an RGBA8 image (top row first), in order.
+Expected<std::vector<std::vector<uint8_t>>> render_scene(const Scene &scene, const FdpSet *fdps,
+                                                         const SceneRenderOptions &options);
+
+// Renders the views side by side into one PNG (atomic).
+Status render_scene_png(const Scene &scene, const FdpSet *fdps, const SceneRenderOptions &options,
+                        const std::string &path);
+
+}  // namespace afmb

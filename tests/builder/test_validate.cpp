@@ -1,0 +1,228 @@
+// check_skin on real skins and on small broken ones.
+#include <gtest/gtest.h>
+
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "../common/test_paths.h"
+#include "core/validate.h"
+#include "io/mesh_io.h"
+#include "io/vrml.h"
+
+namespace {
+
+using afmb::Part;
+using afmb::Scene;
+
+// An nx x ny grid of unit squares in z = 0, two triangles each,
+// counter-clockwise seen from +z. Vertex (i, j) is i + (nx + 1) j; square
+// (i, j) holds triangles 2 (i + nx j) and 2 (i + nx j) + 1.
+Scene grid(int nx = 3, int ny = 3) {
+  Scene s;
+  s.source = "grid.obj";
+  Part p;
+  p.name = "skin";
+  const int w = nx + 1;
+  p.V.resize(w * (ny + 1), 3);
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i <= nx; ++i) p.V.row(i + w * j) << i, j, 0;
+  p.F.resize(2 * nx * ny, 3);
+  int t = 0;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const int a = i + w * j, b = a + 1, c = a + w + 1, d = a + w;
+      p.F.row(t++) << a, b, c;
+      p.F.row(t++) << a, c, d;
+    }
+  s.parts.push_back(p);
+  return s;
+}
+
+void add_triangle(Part &p, int a, int b, int c) {
+  p.F.conservativeResize(p.F.rows() + 1, 3);
+  p.F.row(p.F.rows() - 1) << a, b, c;
+}
+
+TEST(Validate, SongHeadFailsOnlyOnItsCoincidentCornerTriangles) {
+  AFM_REQUIRE_SHARED_DATA();
+  auto song = afmb::read_vrml(afmtest::shared_data("faces/song/song.WRL"));
+  ASSERT_TRUE(song) << song.status().message();
+  const int head = song->find_part("song_head");
+  ASSERT_GE(head, 0);
+  Part &p = song->parts[head];
+  // Triangles with two corners at bit-identical positions (an exporter's
+  // duplicate vertices), found here without check_skin.
+  std::vector<int> flat;
+  for (int t = 0; t < p.F.rows(); ++t)
+    for (int k = 0; k < 3; ++k)
+      if (p.V.row(p.F(t, k)) == p.V.row(p.F(t, (k + 1) % 3))) {
+        flat.push_back(t);
+        break;
+      }
+  ASSERT_FALSE(flat.empty());
+  afmb::Status st = afmb::check_skin(*song, head);
+  ASSERT_FALSE(st);
+  EXPECT_NE(st.message().find("part 'song_head': triangle " + std::to_string(flat[0]) + " ("),
+            std::string::npos) << st.message();
+  EXPECT_NE(st.message().find("is degenerate: area 0 "), std::string::npos) << st.message();
+  // Without them the head is an edge-manifold, consistently oriented skin.
+  Eigen::MatrixXi kept(p.F.rows() - static_cast<int>(flat.size()), 3);
+  for (int t = 0, r = 0, f = 0; t < p.F.rows(); ++t) {
+    if (f < static_cast<int>(flat.size()) && flat[f] == t) {
+      ++f;
+      continue;
+    }
+    kept.row(r++) = p.F.row(t);
+  }
+  p.F = kept;
+  st = afmb::check_skin(*song, head);
+  EXPECT_TRUE(st) << st.message();
+}
+
+TEST(Validate, CandideOrientationVerdictMatchesItsFaceLines) {
+  AFM_REQUIRE_SHARED_DATA();
+  const std::string path = afmtest::shared_data("faces/candide3/candide3.wfm.obj");
+  // Independent: does any directed edge appear twice among the `f` lines?
+  std::set<std::pair<int, int>> seen;
+  bool repeated = false;
+  std::istringstream in(afmtest::read_file(path));
+  std::string line;
+  while (std::getline(in, line)) {
+    std::istringstream w(line);
+    std::string key;
+    w >> key;
+    if (key != "f") continue;
+    std::vector<int> v;
+    std::string c;
+    while (w >> c) v.push_back(std::stoi(c.substr(0, c.find('/'))));
+    for (size_t k = 0; k < v.size(); ++k)
+      repeated |= !seen.insert({v[k], v[(k + 1) % v.size()]}).second;
+  }
+  auto candide = afmb::read_scene(path);
+  ASSERT_TRUE(candide) << candide.status().message();
+  afmb::Status st = afmb::check_skin(*candide, 0);
+  EXPECT_EQ(static_cast<bool>(st), !repeated) << st.message();
+  if (repeated) {
+    EXPECT_NE(st.message().find("inconsistent orientation"), std::string::npos) << st.message();
+  }
+}
+
+TEST(Validate, GridWithBoundaryPasses) {
+  Scene s = grid();
+  EXPECT_TRUE(afmb::check_skin(s, 0));
+}
+
+TEST(Validate, ClosedSlitWithCoincidentVerticesPasses) {
+  // A 5 x 3 grid cut along y = 1 from x = 1 to x = 4, like a closed mouth:
+  // the corners (1,1) and (4,1) stay shared, the triangles above the cut get
+  // their own copies of (2,1) and (3,1), at the same positions.
+  Scene s = grid(5, 3);
+  Part &p = s.parts[0];
+  const int a = 2 + 6 * 1, b = 3 + 6 * 1;
+  const int a2 = static_cast<int>(p.V.rows()), b2 = a2 + 1;
+  p.V.conservativeResize(a2 + 2, 3);
+  p.V.row(a2) = p.V.row(a);
+  p.V.row(b2) = p.V.row(b);
+  int changed = 0;
+  for (int t = 0; t < p.F.rows(); ++t) {
+    bool above = true;
+    for (int k = 0; k < 3; ++k) above = above && p.V(p.F(t, k), 1) >= 1;
+    for (int k = 0; above && k < 3; ++k) {
+      if (p.F(t, k) == a) p.F(t, k) = a2, ++changed;
+      if (p.F(t, k) == b) p.F(t, k) = b2, ++changed;
+    }
+  }
+  ASSERT_GT(changed, 0);
+  afmb::Status st = afmb::check_skin(s, 0);
+  EXPECT_TRUE(st) << st.message();
+}
+
+TEST(Validate, TinyButRealTrianglesPass) {
+  Scene s = grid();
+  Part &p = s.parts[0];
+  // A triangle of area 5e-7 on its own, 1e-4 of the model's size across
+  // (the threshold is 1e-10 * diag^2 = 2e-8).
+  p.V.conservativeResize(19, 3);
+  p.V.row(16) << 10, 10, 0;
+  p.V.row(17) << 10 + 1e-3, 10, 0;
+  p.V.row(18) << 10, 10 + 1e-3, 0;
+  add_triangle(p, 16, 17, 18);
+  afmb::Status st = afmb::check_skin(s, 0);
+  EXPECT_TRUE(st) << st.message();
+}
+
+TEST(ValidateErrors, NonManifoldEdge) {
+  Scene s = grid();
+  Part &p = s.parts[0];
+  // A fin: a third triangle on the diagonal 5-10 of square (1,1), which its
+  // triangles 8 and 9 already share, to a point above.
+  p.V.conservativeResize(17, 3);
+  p.V.row(16) << 1.5, 1.5, 1;
+  add_triangle(p, 5, 10, 16);
+  afmb::Status st = afmb::check_skin(s, 0);
+  ASSERT_FALSE(st);
+  EXPECT_EQ(st.message(), "grid.obj: part 'skin': edge 5-10 is shared by 3 triangles (8, 9, 18): not edge-manifold");
+}
+
+TEST(ValidateErrors, InconsistentOrientation) {
+  Scene s = grid();
+  Part &p = s.parts[0];
+  std::swap(p.F(9, 1), p.F(9, 2));  // triangle 9 = (5, 10, 9) becomes (5, 9, 10)
+  afmb::Status st = afmb::check_skin(s, 0);
+  ASSERT_FALSE(st);
+  EXPECT_NE(st.message().find("part 'skin': triangles"), std::string::npos) << st.message();
+  EXPECT_NE(st.message().find("inconsistent orientation"), std::string::npos) << st.message();
+  EXPECT_NE(st.message().find(" 9 "), std::string::npos) << st.message();
+}
+
+TEST(ValidateErrors, DegenerateTriangles) {
+  {
+    Scene s = grid();
+    s.parts[0].F(4, 2) = s.parts[0].F(4, 0);
+    afmb::Status st = afmb::check_skin(s, 0);
+    ASSERT_FALSE(st);
+    EXPECT_EQ(st.message(), "grid.obj: part 'skin': triangle 4 (2, 3, 2) repeats a vertex");
+  }
+  {
+    // Collinear: vertices 0, 1, 2 lie on y = 0.
+    Scene s = grid();
+    add_triangle(s.parts[0], 0, 1, 2);
+    afmb::Status st = afmb::check_skin(s, 0);
+    ASSERT_FALSE(st);
+    EXPECT_EQ(st.message().rfind("grid.obj: part 'skin': triangle 18 (0, 1, 2) is degenerate: area 0", 0), 0u)
+        << st.message();
+  }
+  {
+    // Distinct vertices at (almost) one point.
+    Scene s = grid();
+    Part &p = s.parts[0];
+    p.V.conservativeResize(19, 3);
+    p.V.row(16) << 7, 7, 0;
+    p.V.row(17) << 7 + 1e-9, 7, 0;
+    p.V.row(18) << 7, 7 + 1e-9, 0;
+    add_triangle(p, 16, 17, 18);
+    afmb::Status st = afmb::check_skin(s, 0);
+    ASSERT_FALSE(st);
+    EXPECT_NE(st.message().find("triangle 18 (16, 17, 18) is degenerate"), std::string::npos) << st.message();
+  }
+}
+
+TEST(ValidateErrors, IndicesPartsAndEmptiness) {
+  Scene s = grid();
+  s.parts[0].F(3, 1) = 99;
+  afmb::Status st = afmb::check_skin(s, 0);
+  ASSERT_FALSE(st);
+  EXPECT_NE(st.message().find("vertex index 99 out of range (16 vertices)"), std::string::npos) << st.message();
+  st = afmb::check_skin(s, 3);
+  ASSERT_FALSE(st);
+  EXPECT_EQ(st.message(), "grid.obj: no part 3 (1 parts)");
+  Scene e = grid();
+  e.parts[0].F.resize(0, 3);
+  st = afmb::check_skin(e, 0);
+  ASSERT_FALSE(st);
+  EXPECT_EQ(st.message(), "grid.obj: part 'skin': no triangles");
+}
+
+}  // namespace

@@ -1,0 +1,131 @@
+#!/bin/sh
+# Command-line behaviour of the tools: --help, bad input (a clear message that
+# names the file and line, part or FDP; exit 1; no output file, and an
+# existing output left untouched), and the raw <-> draco round trip.
+set -u
+: "${AFM_BUILD:=build}"
+bin="$AFM_BUILD/bin"
+tmp="$AFM_BUILD/test-output/cli-tools"
+rm -rf "$tmp"
+mkdir -p "$tmp"
+failures=0
+
+fail() {
+  echo "FAIL: $*"
+  failures=$((failures + 1))
+}
+
+# expect_error NAME STATUS PATTERN OUTPUT -- COMMAND...: the command exits with
+# STATUS, its stderr matches PATTERN (grep -E), and OUTPUT does not exist.
+expect_error() {
+  name=$1 status=$2 pattern=$3 output=$4
+  shift 5
+  "$@" >"$tmp/out.txt" 2>"$tmp/err.txt"
+  got=$?
+  if [ "$got" -ne "$status" ]; then
+    fail "$name: exit $got, expected $status"
+    sed 's/^/    /' "$tmp/err.txt"
+  elif ! grep -Eq -- "$pattern" "$tmp/err.txt"; then
+    fail "$name: message does not match '$pattern':"
+    sed 's/^/    /' "$tmp/err.txt"
+  fi
+  if [ "$output" != "-" ] && [ -e "$output" ]; then
+    fail "$name: left $output behind"
+  fi
+  if ls "$tmp"/*.tmp* >/dev/null 2>&1; then
+    fail "$name: left a temporary file: $(ls "$tmp"/*.tmp*)"
+  fi
+}
+
+for t in afm-headgen afm-import afm-info afm-pack; do
+  "$bin/$t" --help >"$tmp/help.txt" 2>&1 || fail "$t --help exits non-zero"
+  grep -q "usage: $t" "$tmp/help.txt" || fail "$t --help prints no usage line"
+  "$bin/$t" --no-such-option >/dev/null 2>&1
+  [ $? -eq 2 ] || fail "$t: an unknown option does not exit 2"
+done
+
+# A small valid head to spoil.
+"$bin/afm-headgen" --vertices 1500 -o "$tmp/head.obj" --fdp "$tmp/head.fdp" >/dev/null ||
+  fail "afm-headgen failed"
+"$bin/afm-import" "$tmp/head.obj" "$tmp/head.fdp" -o "$tmp/head.afm" >/dev/null ||
+  fail "afm-import of the generated head failed"
+
+# --- missing file, unknown format
+expect_error "missing mesh" 1 "nope\.obj" "$tmp/a.afm" -- \
+  "$bin/afm-import" "$tmp/nope.obj" "$tmp/head.fdp" -o "$tmp/a.afm"
+printf 'solid\n' >"$tmp/mesh.xyz"
+expect_error "unknown mesh format" 1 "mesh\.xyz" "$tmp/a.afm" -- \
+  "$bin/afm-import" "$tmp/mesh.xyz" "$tmp/head.fdp" -o "$tmp/a.afm"
+expect_error "missing FDP file" 1 "nope\.fdp" "$tmp/a.afm" -- \
+  "$bin/afm-import" "$tmp/head.obj" "$tmp/nope.fdp" -o "$tmp/a.afm"
+
+# --- unknown FDP name, FDP on a vertex that does not exist, FDPs missing for FAPU
+line=$(grep -n '^2\.10[[:space:]]' "$tmp/head.fdp" | head -1 | cut -d: -f1)
+sed "${line}s/^2\.10/2.99/" "$tmp/head.fdp" >"$tmp/bad-name.fdp"
+expect_error "unknown FDP name" 1 "bad-name\.fdp:$line:.*2\.99" "$tmp/a.afm" -- \
+  "$bin/afm-import" "$tmp/head.obj" "$tmp/bad-name.fdp" -o "$tmp/a.afm"
+line=$(grep -n '^9\.3[[:space:]]' "$tmp/head.fdp" | head -1 | cut -d: -f1)
+awk -v n="$line" 'NR == n { $3 = 9999999 } { print }' "$tmp/head.fdp" >"$tmp/bad-vertex.fdp"
+expect_error "FDP on a missing vertex" 1 "bad-vertex\.fdp:$line:.*9\.3.*9999999" "$tmp/a.afm" -- \
+  "$bin/afm-import" "$tmp/head.obj" "$tmp/bad-vertex.fdp" -o "$tmp/a.afm"
+grep -v '^3\.6[[:space:]]' "$tmp/head.fdp" >"$tmp/no-36.fdp"
+expect_error "FDP missing for FAPU" 1 "ES0.*3\.6" "$tmp/a.afm" -- \
+  "$bin/afm-import" "$tmp/head.obj" "$tmp/no-36.fdp" -o "$tmp/a.afm"
+
+# --- wrong orientation: named, with the fix
+awk '/^v / { print "v", $2, -$4, $3; next } { print }' "$tmp/head.obj" >"$tmp/zup.obj"
+expect_error "z-up mesh" 1 "--orient" "$tmp/a.afm" -- \
+  "$bin/afm-import" "$tmp/zup.obj" "$tmp/head.fdp" -o "$tmp/a.afm"
+"$bin/afm-import" "$tmp/zup.obj" "$tmp/head.fdp" -o "$tmp/zup.afm" --orient auto >/dev/null ||
+  fail "--orient auto does not fix a z-up mesh"
+
+# --- non-manifold and degenerate skin: a fourth triangle on a skin edge, and a
+# triangle with two equal corners, appended inside the skin group.
+skin_first=$(awk '/^o skin/ { s = 1 } s && /^f / { print; exit }' "$tmp/head.obj")
+set -- $skin_first
+a=${2%%/*} b=${3%%/*} c=${4%%/*}
+awk -v tri="f $a $b $c" '/^o skin/ { s = 1 } s && /^f / && !done { print tri; print tri; done = 1 } { print }' \
+  "$tmp/head.obj" >"$tmp/nonmanifold.obj"
+expect_error "non-manifold skin" 1 "skin.*(edge|manifold)" "$tmp/a.afm" -- \
+  "$bin/afm-import" "$tmp/nonmanifold.obj" "$tmp/head.fdp" -o "$tmp/a.afm"
+awk -v tri="f $a $a $b" '/^o skin/ { s = 1 } s && /^f / && !done { print tri; done = 1 } { print }' \
+  "$tmp/head.obj" >"$tmp/repeated.obj"
+expect_error "repeated corner" 1 "repeated\.obj:[0-9]+:.*twice" "$tmp/a.afm" -- \
+  "$bin/afm-import" "$tmp/repeated.obj" "$tmp/head.fdp" -o "$tmp/a.afm"
+# Three new collinear vertices and a zero-area triangle on them, in the skin.
+nv=$(grep -c '^v ' "$tmp/head.obj")
+awk -v n="$nv" '/^o skin/ { s = 1 }
+  s && /^f / && !done { print "f", n + 1, n + 2, n + 3; done = 1 }
+  { print }
+  END { print "v 0 0 0.5"; print "v 0 0.001 0.5"; print "v 0 0.002 0.5" }' \
+  "$tmp/head.obj" >"$tmp/degenerate.obj"
+expect_error "degenerate skin" 1 "skin.*degenerate" "$tmp/a.afm" -- \
+  "$bin/afm-import" "$tmp/degenerate.obj" "$tmp/head.fdp" -o "$tmp/a.afm"
+
+# --- a failed run leaves an existing output untouched
+cp "$tmp/head.afm" "$tmp/keep.afm"
+"$bin/afm-import" "$tmp/head.obj" "$tmp/no-36.fdp" -o "$tmp/keep.afm" >/dev/null 2>&1
+cmp -s "$tmp/head.afm" "$tmp/keep.afm" || fail "a failed import changed an existing output"
+
+# --- afm-info and afm-pack on bad files
+head -c 100 "$tmp/head.afm" >"$tmp/truncated.afm"
+expect_error "truncated AFM" 1 "truncated\.afm" - -- "$bin/afm-info" "$tmp/truncated.afm"
+expect_error "not an AFM" 1 "magic" - -- "$bin/afm-info" "$tmp/head.fdp"
+expect_error "pack a truncated AFM" 1 "truncated\.afm" "$tmp/p.afm" -- \
+  "$bin/afm-pack" --draco "$tmp/truncated.afm" "$tmp/p.afm"
+expect_error "pack into a missing directory" 1 "no/such/dir" - -- \
+  "$bin/afm-pack" --draco "$tmp/head.afm" "$tmp/no/such/dir/p.afm"
+
+# --- raw -> draco -> raw is exact, and afm-info reads both
+"$bin/afm-pack" --draco "$tmp/head.afm" "$tmp/head-draco.afm" >/dev/null || fail "afm-pack --draco"
+"$bin/afm-pack" --raw "$tmp/head-draco.afm" "$tmp/head-raw.afm" >/dev/null || fail "afm-pack --raw"
+cmp -s "$tmp/head.afm" "$tmp/head-raw.afm" || fail "raw -> draco -> raw changed the file"
+"$bin/afm-info" "$tmp/head-draco.afm" >"$tmp/info.txt" || fail "afm-info on a draco file"
+grep -q "GEOM  draco" "$tmp/info.txt" || fail "afm-info does not show the draco GEOM chunk"
+grep -q "skin .*skin" "$tmp/info.txt" || fail "afm-info does not list the skin part"
+
+if [ "$failures" -ne 0 ]; then
+  echo "test_tools.sh: $failures failures"
+  exit 1
+fi
+echo "test_tools.sh: all passed"
