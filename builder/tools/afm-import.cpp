@@ -188,7 +188,11 @@ int main(int argc, char **argv) {
     }
     std::printf("\n");
   }
-  if (!notes.empty()) std::printf("  note: %s\n", notes.c_str());
+  for (size_t at = 0, end; at < notes.size(); at = end + 1) {
+    end = notes.find('\n', at);
+    if (end == std::string::npos) end = notes.size();
+    if (end > at) std::printf("  note: %s\n", notes.substr(at, end - at).c_str());
+  }
 
   AfmContent content;
   content.scene = &*scene;
