@@ -8,6 +8,7 @@
 #include <string>
 
 #include "afm/afm_export.h"
+#include "afm/analytic_targets.h"
 #include "core/fapu.h"
 #include "core/orient.h"
 #include "core/part_kind.h"
@@ -27,7 +28,7 @@ void usage(FILE *out) {
       "\n"
       "Reads a face mesh and its MPEG-4 feature points, checks them, prints the FAP\n"
       "units and an FDP summary, and writes a neutral Animatable Face Model (no morph\n"
-      "targets yet: afm-build makes those).\n"
+      "targets unless --analytic: afm-build makes real ones).\n"
       "\n"
       "  MESH                 .wrl/.vrml (VRML97, several named parts), .obj (o/g groups\n"
       "                       become parts), .ply, .off, .stl\n"
@@ -41,6 +42,11 @@ void usage(FILE *out) {
       "                       in the MPEG-4 frame is refused with the value to use.\n"
       "  --fdp-format F       auto (default), xfaceed, text or visage\n"
       "  --profile P          raw (default) or draco (formats/afm.md)\n"
+      "  --analytic           add analytic stand-in morph targets (a smooth bump per\n"
+      "                       FAP that moves its FDP exactly as MPEG-4 says; visemes,\n"
+      "                       expressions) and rigid eyes, jaw and head: test models\n"
+      "                       for players, not anatomy (afm-build makes those)\n"
+      "  --normal-deltas      with --analytic: store normal deltas too\n"
       "  --fdps               list every FDP\n"
       "  --help               this text\n"
       "\n"
@@ -59,7 +65,7 @@ int main(int argc, char **argv) {
   std::string mesh_path, fdp_path, out_path, orient_spec;
   FdpFormat fdp_format = FdpFormat::Auto;
   afm_profile profile = AFM_PROFILE_RAW;
-  bool list_fdps = false;
+  bool list_fdps = false, analytic = false, normal_deltas = false;
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
     auto value = [&](const char *name) -> const char * {
@@ -96,6 +102,10 @@ int main(int argc, char **argv) {
       }
     } else if (a == "--fdps") {
       list_fdps = true;
+    } else if (a == "--analytic") {
+      analytic = true;
+    } else if (a == "--normal-deltas") {
+      normal_deltas = true;
     } else if (a.size() > 1 && a[0] == '-') {
       std::fprintf(stderr, "afm-import: unknown option '%s' (see --help)\n", a.c_str());
       return 2;
@@ -198,11 +208,24 @@ int main(int argc, char **argv) {
   content.scene = &*scene;
   content.fdps = &*fdps;
   content.fapu = f;
-  content.generator = "afm-import";
+  content.generator = analytic ? "afm-import --analytic" : "afm-import";
+  if (analytic) {
+    AnalyticOptions ao;
+    ao.normal_deltas = normal_deltas;
+    Expected<AnalyticModel> model = make_analytic_model(*scene, *fdps, f, ao);
+    if (!model) return fail(model.status());
+    content.targets = std::move(model->targets);
+    content.rigids = std::move(model->rigids);
+  }
   Expected<std::vector<uint8_t>> bytes = encode_afm(content, profile);
   if (!bytes) return fail(bytes.status().wrap(out_path));
   if (Status s = write_file_atomic(out_path, bytes->data(), bytes->size()); !s) return fail(s);
-  std::printf("wrote %s: %zu bytes, %s profile, neutral (no morph targets)\n", out_path.c_str(),
-              bytes->size(), profile == AFM_PROFILE_RAW ? "raw" : "draco");
+  if (analytic)
+    std::printf("wrote %s: %zu bytes, %s profile, %zu analytic morph targets, %zu rigid parts\n",
+                out_path.c_str(), bytes->size(), profile == AFM_PROFILE_RAW ? "raw" : "draco",
+                content.targets.size(), content.rigids.size());
+  else
+    std::printf("wrote %s: %zu bytes, %s profile, neutral (no morph targets)\n", out_path.c_str(),
+                bytes->size(), profile == AFM_PROFILE_RAW ? "raw" : "draco");
   return 0;
 }

@@ -24,6 +24,8 @@ const char *afm_result_string(afm_result result) {
     case AFM_ERR_OUT_OF_MEMORY: return "out of memory";
     case AFM_ERR_IO: return "I/O error";
     case AFM_ERR_LIMIT: return "format limit exceeded";
+    case AFM_ERR_SYNTAX: return "syntax error";
+    case AFM_ERR_STATE: return "call out of order";
   }
   return "unknown error";
 }

@@ -7,7 +7,7 @@
 #include <memory>
 #include <random>
 
-#include "synthetic_doc.h"
+#include "../common/synthetic_doc.h"
 
 using afmtest::compare_docs;
 using afmtest::make_synthetic_doc;

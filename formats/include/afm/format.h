@@ -56,7 +56,9 @@ typedef enum afm_result {
   AFM_ERR_BUFFER_TOO_SMALL = 15, /* caller's buffer smaller than measured */
   AFM_ERR_OUT_OF_MEMORY = 16,
   AFM_ERR_IO = 17,               /* open, read, write or rename failed */
-  AFM_ERR_LIMIT = 18             /* beyond a format limit (4 GiB file, 65535 parts) */
+  AFM_ERR_LIMIT = 18,            /* beyond a format limit (4 GiB file, 65535 parts) */
+  AFM_ERR_SYNTAX = 19,           /* a text stream (.fap) does not parse; see afm_diag.line */
+  AFM_ERR_STATE = 20             /* a call out of order (e.g. feeding a finished reader) */
 } afm_result;
 
 /* Short English text for a result ("chunk CRC mismatch"). Never NULL. */
@@ -67,6 +69,7 @@ typedef struct afm_diag {
   char message[256]; /* e.g. "GEOM: triangle 12: index 5001 >= part end 5000" */
   uint32_t chunk;    /* fourcc of the chunk being read, 0 for the container */
   uint64_t offset;   /* byte offset in the file of the offending field */
+  uint32_t line;     /* text streams: 1-based line of the error; 0 otherwise */
 } afm_diag;
 
 /* An allocator passed per call. Zeroed: malloc and free. */

@@ -1,0 +1,159 @@
+/* The blend kernel: positions = neutral + sum over targets of weight * delta.
+ *
+ * Data layout (all from the AFM's MTGT chunk, untouched): per target, runs of
+ * consecutive vertices and planar int16 deltas (x[], y[], z[]). Accumulators
+ * are planar int32 arrays, one per coordinate, so one run of one target is a
+ * contiguous multiply-add of int16 by a constant into int32 (pmaddwd/pmullw-
+ * class instructions on x86, SMLABB on ARMv5TE).
+ *
+ * Q formats and widths (per coordinate):
+ *   delta d        int16, position quanta (normal deltas: Q14)
+ *   weight w       Q12 within [-2^15, 2^15), pre-shifted by (12 - shift)
+ *   product w * d  int32, |w * d| < 2^30
+ *   accumulator    int32 in Q(shift): neutral << shift plus the products
+ *   output         round(acc / 2^shift), halves up: one rounding per pose
+ * Overflow: the pose picks shift (12 normally) so that |neutral << shift| +
+ * sum over active targets of |w| * max|d| < 2^31 (see afm_player_pose); no
+ * intermediate can then overflow. Rounding happens once, at the output.
+ *
+ * Between poses the accumulators hold neutral << acc_shift everywhere except
+ * the spans the last pose moved (`dirty`): the next pose resets those first,
+ * so a pose costs O(updates + moved vertices), not O(vertices). */
+#include <string.h>
+
+#include "player_internal.h"
+
+/* Writes neutral << shift into the accumulators of [s, e). */
+static void reset_span(afm_player *p, uint32_t s, uint32_t e, int shift) {
+  const afm_geometry *g = &p->doc->geometry;
+  const uint32_t V = p->vertex_count;
+  int32_t *ax = p->acc, *ay = p->acc + V, *az = p->acc + 2 * (size_t)V;
+  uint32_t v;
+  for (v = s; v < e; ++v) ax[v] = (int32_t)g->px[v] * ((int32_t)1 << shift);
+  for (v = s; v < e; ++v) ay[v] = (int32_t)g->py[v] * ((int32_t)1 << shift);
+  for (v = s; v < e; ++v) az[v] = (int32_t)g->pz[v] * ((int32_t)1 << shift);
+  if (p->normal_acc) {
+    int32_t *nx = p->normal_acc, *ny = nx + V, *nz = nx + 2 * (size_t)V;
+    for (v = s; v < e; ++v) nx[v] = (int32_t)g->nx[v] * ((int32_t)1 << shift);
+    for (v = s; v < e; ++v) ny[v] = (int32_t)g->ny[v] * ((int32_t)1 << shift);
+    for (v = s; v < e; ++v) nz[v] = (int32_t)g->nz[v] * ((int32_t)1 << shift);
+  }
+}
+
+void afm_blend_reset(afm_player *p, int shift) {
+  reset_span(p, 0, p->vertex_count, shift);
+  p->acc_shift = shift;
+  p->dirty_count = 0;
+}
+
+void afm_blend_restore(afm_player *p) {
+  uint32_t i;
+  for (i = 0; i < p->dirty_count; ++i) reset_span(p, p->dirty[i].start, p->dirty[i].end, p->acc_shift);
+  p->dirty_count = 0;
+}
+
+/* acc[i] += w * d[i]: the kernel. A 16 x 16 -> 32-bit multiply-add:
+ * |w| < 2^15, |d| < 2^15, so |w * d| < 2^30. Written so that compilers see
+ * the widening multiply (pmullw/pmulhw on x86, SMLABB on ARMv5TE). */
+static void axpy16(int32_t *restrict acc, const int16_t *restrict d, int16_t w, uint32_t n) {
+  uint32_t i;
+  for (i = 0; i < n; ++i) acc[i] += (int32_t)w * (int32_t)d[i];
+}
+
+static void blend_runs(int32_t *acc, uint32_t V, const afm_target *t, const int16_t *dx,
+                       const int16_t *dy, const int16_t *dz, int16_t w) {
+  uint32_t r, k = 0;
+  for (r = 0; r < t->run_count; ++r) {
+    uint32_t s = t->runs[r].start, n = t->runs[r].length;
+    axpy16(acc + s, dx + k, w, n);
+    axpy16(acc + V + s, dy + k, w, n);
+    axpy16(acc + 2 * (size_t)V + s, dz + k, w, n);
+    k += n;
+  }
+}
+
+void afm_blend_targets(afm_player *p, int shift) {
+  const afm_doc *doc = p->doc;
+  uint32_t i, r, lo = p->vertex_count, hi = 0;
+  for (i = 0; i < p->target_count; ++i) {
+    const afm_target *t = &doc->targets[i];
+    int32_t w = p->weights[i];
+    if (!w) continue;
+    if (shift < kWeightBits) w = afm_round_shift32(w, kWeightBits - shift);
+    blend_runs(p->acc, p->vertex_count, t, t->dx, t->dy, t->dz, (int16_t)w);
+    if (p->normal_acc && t->nx)
+      blend_runs(p->normal_acc, p->vertex_count, t, t->nx, t->ny, t->nz, (int16_t)w);
+    /* Mark the moved vertices; spans come from one scan below. */
+    for (r = 0; r < t->run_count; ++r) {
+      uint32_t s = t->runs[r].start, e = s + t->runs[r].length;
+      memset(p->moved + s, 1, t->runs[r].length);
+      if (s < lo) lo = s;
+      if (e > hi) hi = e;
+    }
+  }
+  /* The marked vertices as sorted, disjoint spans; marks cleared on the way. */
+  p->dirty_count = 0;
+  while (lo < hi) {
+    const uint8_t *start = (const uint8_t *)memchr(p->moved + lo, 1, hi - lo), *end;
+    if (!start) break;
+    lo = (uint32_t)(start - p->moved);
+    end = (const uint8_t *)memchr(start, 0, hi - lo);
+    p->dirty[p->dirty_count].start = lo;
+    lo = end ? (uint32_t)(end - p->moved) : hi;
+    p->dirty[p->dirty_count].end = lo;
+    memset(p->moved + p->dirty[p->dirty_count].start, 0, lo - p->dirty[p->dirty_count].start);
+    p->dirty_count++;
+  }
+}
+
+void afm_blend_output(afm_player *p, int shift) {
+  const uint32_t V = p->vertex_count;
+  const int32_t *ax = p->acc, *ay = p->acc + V, *az = p->acc + 2 * (size_t)V;
+  uint32_t i, v;
+  for (i = 0; i < p->dirty_count; ++i) {
+    const afm_span s = p->dirty[i];
+    for (v = s.start; v < s.end; ++v) {
+      int32_t *o = p->positions + 3 * (size_t)v;
+      /* |acc| < 2^31 - 2^(shift-1) by the pose's bound: the rounding add fits. */
+      o[0] = shift ? afm_round_shift32(ax[v], shift) : ax[v];
+      o[1] = shift ? afm_round_shift32(ay[v], shift) : ay[v];
+      o[2] = shift ? afm_round_shift32(az[v], shift) : az[v];
+    }
+    if (p->normal_acc) {
+      const int32_t *nx = p->normal_acc, *ny = nx + V, *nz = nx + 2 * (size_t)V;
+      for (v = s.start; v < s.end; ++v) afm_normalize_q14(nx[v], ny[v], nz[v], p->normals + 3 * (size_t)v);
+    }
+    afm_add_restore_span(p, s.start, s.end);
+  }
+}
+
+void afm_add_restore_span(afm_player *p, uint32_t start, uint32_t end) {
+  if (p->restore_count < p->restore_capacity) {
+    p->restore[p->restore_count].start = start;
+    p->restore[p->restore_count].end = end;
+    p->restore_count++;
+  } else {
+    /* Cannot happen with the capacity init reserves; stay correct anyway by
+     * widening the last span. */
+    afm_span *last = &p->restore[p->restore_capacity - 1];
+    if (start < last->start) last->start = start;
+    if (end > last->end) last->end = end;
+  }
+}
+
+void afm_restore_outputs(afm_player *p) {
+  const afm_geometry *g = &p->doc->geometry;
+  uint32_t i, v;
+  for (i = 0; i < p->restore_count; ++i) {
+    for (v = p->restore[i].start; v < p->restore[i].end; ++v) {
+      int32_t *o = p->positions + 3 * (size_t)v;
+      afm_q14 *n = p->normals + 3 * (size_t)v;
+      o[0] = g->px[v], o[1] = g->py[v], o[2] = g->pz[v];
+      if (g->nx)
+        n[0] = g->nx[v], n[1] = g->ny[v], n[2] = g->nz[v];
+      else
+        n[0] = n[1] = 0, n[2] = AFM_Q14_ONE;
+    }
+  }
+  p->restore_count = 0;
+}

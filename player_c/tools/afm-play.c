@@ -1,0 +1,335 @@
+/* afm-play: play a FAP stream on an AFM, print a line (or hash) per frame. */
+#define _POSIX_C_SOURCE 199309L
+#include <errno.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "afm/draco.h"
+#include "afm/fap_stream.h"
+#include "afm/format.h"
+#include "afm/player.h"
+
+static void usage(FILE *out) {
+  fprintf(out,
+          "usage: afm-play MODEL.afm STREAM.fap [options]\n"
+          "\n"
+          "Plays an MPEG-4 FAP stream on an Animatable Face Model with the fixed-point\n"
+          "player and prints one line per frame: frame, time, active morph targets,\n"
+          "vertex-target updates and a hash of the pose.\n"
+          "\n"
+          "  --fps N          render at N frames per second (default: the stream's own\n"
+          "                   rate); in-between poses are interpolated, no frame's values\n"
+          "                   are dropped\n"
+          "  --obj DIR        write each rendered frame as DIR/frame_NNNNN.obj (model\n"
+          "                   units, normals, texture coordinates, one group per part)\n"
+          "  --stats          time per frame (min, median, max) and memory used\n"
+          "  --mirror LIST    copy one-sided FAPs to the other side: lr (left/right),\n"
+          "                   io (inner/outer lip) or lr,io; off by default\n"
+          "  --normal-deltas  blend the AFM's stored normal deltas instead of\n"
+          "                   recomputing normals\n"
+          "  --quiet          no per-frame lines, only the summary\n"
+          "  --help           this text\n"
+          "\n"
+          "The hash is FNV-1a 64 over each vertex's x y z (int32 quanta) and normal\n"
+          "(Q14), little-endian: the same on every platform for the same input.\n"
+          "Exit status: 0 on success, 1 on bad input (the message names the file and\n"
+          "line or field), 2 on bad usage.\n");
+}
+
+static double now_seconds(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+static uint64_t pose_hash(const afm_player *p, uint32_t vertices) {
+  const int32_t *x = afm_player_positions(p);
+  const afm_q14 *n = afm_player_normals(p);
+  uint64_t h = 1469598103934665603ull;
+  size_t i;
+  int k;
+  for (i = 0; i < 3 * (size_t)vertices; ++i) {
+    uint32_t u = (uint32_t)x[i];
+    uint16_t m = (uint16_t)n[i];
+    uint8_t b[6];
+    b[0] = (uint8_t)u, b[1] = (uint8_t)(u >> 8), b[2] = (uint8_t)(u >> 16), b[3] = (uint8_t)(u >> 24);
+    b[4] = (uint8_t)m, b[5] = (uint8_t)(m >> 8);
+    for (k = 0; k < 6; ++k) h = (h ^ b[k]) * 1099511628211ull;
+  }
+  return h;
+}
+
+/* A growing text buffer for OBJ output. */
+typedef struct text {
+  char *data;
+  size_t size, capacity;
+  int failed;
+} text;
+
+static void put(text *t, const char *format, ...) {
+  va_list args;
+  int n;
+  if (t->failed) return;
+  for (;;) {
+    va_start(args, format);
+    n = vsnprintf(t->data + t->size, t->capacity - t->size, format, args);
+    va_end(args);
+    if (n < 0) {
+      t->failed = 1;
+      return;
+    }
+    if ((size_t)n < t->capacity - t->size) {
+      t->size += (size_t)n;
+      return;
+    } else {
+      size_t cap = t->capacity * 2 + (size_t)n + 1024;
+      char *d = (char *)realloc(t->data, cap);
+      if (!d) {
+        t->failed = 1;
+        return;
+      }
+      t->data = d;
+      t->capacity = cap;
+    }
+  }
+}
+
+static int write_obj(const char *dir, uint32_t index, const afm_doc *doc, const afm_player *p) {
+  const afm_geometry *g = &doc->geometry;
+  const int32_t *x = afm_player_positions(p);
+  const afm_q14 *n = afm_player_normals(p);
+  char path[4096];
+  text t = {NULL, 0, 0, 0};
+  uint32_t v, part, tri;
+  afm_result r;
+  snprintf(path, sizeof path, "%s/frame_%05lu.obj", dir, (unsigned long)index);
+  t.capacity = 64;
+  t.data = (char *)malloc(t.capacity);
+  if (!t.data) return 0;
+  put(&t, "# afm-play frame %lu of %s\n", (unsigned long)index, doc->meta.name);
+  for (v = 0; v < g->vertex_count; ++v)
+    put(&t, "v %.7g %.7g %.7g\n", (double)g->origin[0] + (double)x[3 * v] * (double)g->step,
+        (double)g->origin[1] + (double)x[3 * v + 1] * (double)g->step,
+        (double)g->origin[2] + (double)x[3 * v + 2] * (double)g->step);
+  for (v = 0; v < g->vertex_count; ++v)
+    put(&t, "vn %.5f %.5f %.5f\n", n[3 * v] / 16384.0, n[3 * v + 1] / 16384.0, n[3 * v + 2] / 16384.0);
+  if (g->u)
+    for (v = 0; v < g->vertex_count; ++v)
+      put(&t, "vt %.6f %.6f\n", (double)g->uv_origin[0] + g->u[v] * (double)g->uv_step[0],
+          (double)g->uv_origin[1] + g->v[v] * (double)g->uv_step[1]);
+  for (part = 0; part < g->part_count; ++part) {
+    const afm_part *a = &g->parts[part];
+    put(&t, "o %s\n", a->name);
+    for (tri = a->first_triangle; tri < a->first_triangle + a->triangle_count; ++tri) {
+      unsigned long i0 = (unsigned long)g->triangles[3 * tri] + 1;
+      unsigned long i1 = (unsigned long)g->triangles[3 * tri + 1] + 1;
+      unsigned long i2 = (unsigned long)g->triangles[3 * tri + 2] + 1;
+      if (g->u)
+        put(&t, "f %lu/%lu/%lu %lu/%lu/%lu %lu/%lu/%lu\n", i0, i0, i0, i1, i1, i1, i2, i2, i2);
+      else
+        put(&t, "f %lu//%lu %lu//%lu %lu//%lu\n", i0, i0, i1, i1, i2, i2);
+    }
+  }
+  r = t.failed ? AFM_ERR_OUT_OF_MEMORY : afm_file_write_atomic(path, (const uint8_t *)t.data, t.size);
+  free(t.data);
+  if (r != AFM_OK) {
+    fprintf(stderr, "afm-play: %s: cannot write: %s\n", path, strerror(errno));
+    return 0;
+  }
+  return 1;
+}
+
+static int compare_double(const void *a, const void *b) {
+  double x = *(const double *)a, y = *(const double *)b;
+  return x < y ? -1 : x > y;
+}
+
+int main(int argc, char **argv) {
+  const char *model_path = NULL, *stream_path = NULL, *obj_dir = NULL;
+  unsigned long fps = 0;
+  int stats = 0, quiet = 0, i;
+  uint32_t mirror = 0, frame_count = 0, rendered = 0, k;
+  afm_player_options po;
+  uint8_t *model_data = NULL, *stream_data = NULL;
+  size_t model_size = 0, stream_size = 0, doc_bytes = 0, player_bytes = 0;
+  afm_doc *doc = NULL;
+  afm_fap_frame *frames = NULL;
+  afm_fap_header header;
+  afm_fap_stats fap_stats;
+  afm_fap_cursor cursor;
+  afm_player *player = NULL;
+  void *player_memory = NULL;
+  double *times = NULL;
+  afm_diag diag;
+  afm_read_options ro;
+  afm_result r;
+  uint64_t duration_us, t_us;
+  int status = 1;
+
+  memset(&po, 0, sizeof po);
+  for (i = 1; i < argc; ++i) {
+    const char *a = argv[i];
+    if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+      usage(stdout);
+      return 0;
+    } else if (!strcmp(a, "--fps") && i + 1 < argc) {
+      char *end;
+      fps = strtoul(argv[++i], &end, 10);
+      if (*end || fps == 0 || fps > 10000) {
+        fprintf(stderr, "afm-play: --fps '%s': a whole number from 1 to 10000\n", argv[i]);
+        return 2;
+      }
+    } else if (!strcmp(a, "--obj") && i + 1 < argc) {
+      obj_dir = argv[++i];
+    } else if (!strcmp(a, "--mirror") && i + 1 < argc) {
+      const char *m = argv[++i];
+      if (!strcmp(m, "lr")) mirror = AFM_MIRROR_LEFT_RIGHT;
+      else if (!strcmp(m, "io")) mirror = AFM_MIRROR_INNER_OUTER;
+      else if (!strcmp(m, "lr,io") || !strcmp(m, "io,lr")) mirror = AFM_MIRROR_LEFT_RIGHT | AFM_MIRROR_INNER_OUTER;
+      else {
+        fprintf(stderr, "afm-play: --mirror '%s': use lr, io or lr,io\n", m);
+        return 2;
+      }
+    } else if (!strcmp(a, "--stats")) {
+      stats = 1;
+    } else if (!strcmp(a, "--quiet")) {
+      quiet = 1;
+    } else if (!strcmp(a, "--normal-deltas")) {
+      po.flags |= AFM_PLAYER_NORMAL_DELTAS;
+    } else if (a[0] == '-' && a[1]) {
+      fprintf(stderr, "afm-play: unknown or incomplete option '%s' (see --help)\n", a);
+      return 2;
+    } else if (!model_path) {
+      model_path = a;
+    } else if (!stream_path) {
+      stream_path = a;
+    } else {
+      fprintf(stderr, "afm-play: too many arguments (see --help)\n");
+      return 2;
+    }
+  }
+  if (!model_path || !stream_path) {
+    usage(stderr);
+    return 2;
+  }
+
+  memset(&diag, 0, sizeof diag);
+  if (afm_file_read(model_path, NULL, &model_data, &model_size) != AFM_OK) {
+    fprintf(stderr, "afm-play: %s: cannot read: %s\n", model_path, strerror(errno));
+    goto done;
+  }
+  ro.draco = afm_draco_codec();
+  ro.diag = &diag;
+  r = afm_doc_measure(model_data, model_size, &ro, &doc_bytes);
+  if (r == AFM_OK) r = afm_doc_read_alloc(model_data, model_size, &ro, NULL, &doc);
+  if (r != AFM_OK) {
+    fprintf(stderr, "afm-play: %s: %s\n", model_path, diag.message[0] ? diag.message : afm_result_string(r));
+    goto done;
+  }
+  if (afm_file_read(stream_path, NULL, &stream_data, &stream_size) != AFM_OK) {
+    fprintf(stderr, "afm-play: %s: cannot read: %s\n", stream_path, strerror(errno));
+    goto done;
+  }
+  memset(&diag, 0, sizeof diag);
+  r = afm_fap_parse(stream_data, stream_size, NULL, NULL, 0, &frame_count, NULL, NULL, &diag);
+  if (r == AFM_OK && frame_count == 0) {
+    fprintf(stderr, "afm-play: %s: the stream has no frames\n", stream_path);
+    goto done;
+  }
+  if (r == AFM_OK) {
+    frames = (afm_fap_frame *)malloc(frame_count * sizeof *frames);
+    if (!frames) r = AFM_ERR_OUT_OF_MEMORY;
+  }
+  if (r == AFM_OK)
+    r = afm_fap_parse(stream_data, stream_size, NULL, frames, frame_count, &frame_count, &header,
+                      &fap_stats, &diag);
+  if (r != AFM_OK) {
+    if (diag.line)
+      fprintf(stderr, "afm-play: %s:%lu: %s\n", stream_path, (unsigned long)diag.line, diag.message);
+    else
+      fprintf(stderr, "afm-play: %s: %s\n", stream_path, diag.message[0] ? diag.message : afm_result_string(r));
+    goto done;
+  }
+
+  r = afm_player_measure(doc, &po, &player_bytes);
+  if (r == AFM_OK) {
+    player_memory = malloc(player_bytes);
+    if (!player_memory) r = AFM_ERR_OUT_OF_MEMORY;
+  }
+  if (r == AFM_OK) r = afm_player_init(doc, &po, player_memory, player_bytes, &player);
+  if (r == AFM_OK) r = afm_fap_cursor_init(&cursor, frames, frame_count, header.fps_num, header.fps_den, mirror);
+  if (r != AFM_OK) {
+    fprintf(stderr, "afm-play: %s: cannot play: %s%s\n", model_path, afm_result_string(r),
+            (po.flags & AFM_PLAYER_NORMAL_DELTAS) && r == AFM_ERR_ARGUMENT ? " (the AFM has no normals)" : "");
+    goto done;
+  }
+
+  duration_us = afm_fap_cursor_duration_us(&cursor);
+  if (!quiet)
+    printf("%s: %lu frames at %lu/%lu fps (%.3f s) on %s (%lu vertices, %lu targets)\n", stream_path,
+           (unsigned long)frame_count, (unsigned long)header.fps_num, (unsigned long)header.fps_den,
+           (double)duration_us * 1e-6, model_path, (unsigned long)doc->geometry.vertex_count,
+           (unsigned long)doc->target_count);
+  {
+    /* Render times: the stream's own frames, or a resampled clock. */
+    uint32_t total = fps ? (uint32_t)(duration_us * fps / 1000000u) + 1 : frame_count;
+    times = (double *)malloc(total * sizeof *times);
+    if (!times) {
+      fprintf(stderr, "afm-play: out of memory\n");
+      goto done;
+    }
+    for (k = 0; k < total; ++k) {
+      const afm_fap_state *a, *b;
+      afm_q16 t;
+      const afm_pose_info *info;
+      double t0;
+      t_us = fps ? (uint64_t)k * 1000000u / fps : 0;
+      if (!fps) {
+        /* Frame k's own time: seek to it exactly. */
+        t_us = (uint64_t)(frames[k].number - frames[0].number) * header.fps_den * 1000000u / header.fps_num;
+      }
+      afm_fap_cursor_seek(&cursor, t_us, &a, &b, &t);
+      t0 = now_seconds();
+      r = afm_player_pose(player, a, b, t);
+      times[k] = now_seconds() - t0;
+      if (r != AFM_OK) {
+        fprintf(stderr, "afm-play: frame %lu: %s\n", (unsigned long)k, afm_result_string(r));
+        goto done;
+      }
+      info = afm_player_info(player);
+      if (!quiet)
+        printf("frame %5lu  t %8.3f s  targets %3lu  updates %7lu  hash %016llx\n", (unsigned long)k,
+               (double)t_us * 1e-6, (unsigned long)info->active_targets, (unsigned long)info->updates,
+               (unsigned long long)pose_hash(player, doc->geometry.vertex_count));
+      if (obj_dir && !write_obj(obj_dir, k, doc, player)) goto done;
+      ++rendered;
+    }
+  }
+  if (stats && rendered) {
+    double sum = 0;
+    qsort(times, rendered, sizeof *times, compare_double);
+    for (k = 0; k < rendered; ++k) sum += times[k];
+    printf("time per frame: min %.1f us, median %.1f us, mean %.1f us, max %.1f us (%lu frames)\n",
+           times[0] * 1e6, times[rendered / 2] * 1e6, sum / rendered * 1e6, times[rendered - 1] * 1e6,
+           (unsigned long)rendered);
+    printf("memory: model %lu bytes (decoded AFM), player %lu bytes, stream %lu bytes (%lu frames "
+           "of %lu bytes); nothing allocated per frame\n",
+           (unsigned long)doc_bytes, (unsigned long)player_bytes,
+           (unsigned long)(frame_count * sizeof *frames), (unsigned long)frame_count,
+           (unsigned long)sizeof *frames);
+    printf("stream: %lu values clamped, %lu with fractions rounded\n", (unsigned long)fap_stats.clamped,
+           (unsigned long)fap_stats.rounded);
+  }
+  status = 0;
+done:
+  free(times);
+  free(player_memory);
+  free(frames);
+  free(stream_data);
+  free(model_data);
+  afm_free(NULL, doc);
+  return status;
+}

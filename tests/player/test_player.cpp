@@ -1,0 +1,490 @@
+// The player core against its double-precision model, MPEG-4 semantics,
+// determinism, and the no-allocation-per-frame promise.
+#include <afm/draco.h>
+#include <afm/format.h>
+#include <afm/mpeg4.h>
+#include <afm/player.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <random>
+
+#include "../common/synthetic_doc.h"
+#include "afm/afm_export.h"
+#include "afm/analytic_targets.h"
+#include "core/fapu.h"
+#include "reference_player.h"
+#include "refhead/refhead.h"
+
+// ---- a counting malloc -------------------------------------------------------------
+// The test binary interposes malloc to count calls made while posing. Under
+// AddressSanitizer the runtime owns malloc, so the count is not available.
+#if defined(__SANITIZE_ADDRESS__)
+#define AFM_COUNT_MALLOC 0
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define AFM_COUNT_MALLOC 0
+#endif
+#endif
+#ifndef AFM_COUNT_MALLOC
+#define AFM_COUNT_MALLOC 1
+#endif
+
+#if AFM_COUNT_MALLOC
+extern "C" {
+void *__libc_malloc(size_t);
+void *__libc_calloc(size_t, size_t);
+void *__libc_realloc(void *, size_t);
+static unsigned long g_allocations = 0;
+void *malloc(size_t n) {
+  ++g_allocations;
+  return __libc_malloc(n);
+}
+void *calloc(size_t a, size_t b) {
+  ++g_allocations;
+  return __libc_calloc(a, b);
+}
+void *realloc(void *p, size_t n) {
+  ++g_allocations;
+  return __libc_realloc(p, n);
+}
+}
+#endif
+
+namespace {
+
+struct DocFree {
+  void operator()(afm_doc *d) const { afm_free(nullptr, d); }
+};
+
+// The reference head with analytic targets, as an AFM document.
+struct Model {
+  std::unique_ptr<afm_doc, DocFree> doc;
+  std::vector<uint64_t> player_memory;
+  afm_player *player = nullptr;
+  double diagonal_quanta = 0;  // bounding-box diagonal of the neutral mesh
+
+  explicit Model(int skin_vertices, uint32_t player_flags = 0, bool normal_deltas = false) {
+    afmb::RefHeadOptions ro;
+    ro.skin_vertices = skin_vertices;
+    afmb::Expected<afmb::RefHead> head = afmb::make_reference_head(ro);
+    EXPECT_TRUE(head.is_ok());
+    afmb::Expected<afmb::Fapu> fapu = afmb::compute_fapu(head->fdps);
+    afmb::AnalyticOptions ao;
+    ao.normal_deltas = normal_deltas;
+    afmb::Expected<afmb::AnalyticModel> am = afmb::make_analytic_model(head->scene, head->fdps, *fapu, ao);
+    EXPECT_TRUE(am.is_ok());
+    afmb::AfmContent content;
+    content.scene = &head->scene;
+    content.fdps = &head->fdps;
+    content.fapu = *fapu;
+    content.targets = am->targets;
+    content.rigids = am->rigids;
+    afmb::Expected<std::vector<uint8_t>> bytes = afmb::encode_afm(content, AFM_PROFILE_RAW);
+    EXPECT_TRUE(bytes.is_ok()) << bytes.status().message();
+    afm_doc *d = nullptr;
+    afm_read_options opt{};
+    EXPECT_EQ(afm_doc_read_alloc(bytes->data(), bytes->size(), &opt, nullptr, &d), AFM_OK);
+    doc.reset(d);
+    init_player(player_flags);
+    int16_t lo[3] = {32767, 32767, 32767}, hi[3] = {-32767, -32767, -32767};
+    const afm_geometry &g = doc->geometry;
+    for (uint32_t v = 0; v < g.vertex_count; ++v) {
+      const int16_t p[3] = {g.px[v], g.py[v], g.pz[v]};
+      for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+    }
+    for (int k = 0; k < 3; ++k) diagonal_quanta += double(hi[k] - lo[k]) * (hi[k] - lo[k]);
+    diagonal_quanta = std::sqrt(diagonal_quanta);
+  }
+
+  void init_player(uint32_t flags) {
+    afm_player_options po{};
+    po.flags = flags;
+    size_t need = 0;
+    ASSERT_EQ(afm_player_measure(doc.get(), &po, &need), AFM_OK);
+    // Garbage, not zeros: init must not rely on a cleared buffer.
+    player_memory.assign(need / 8 + 1, 0xA5A5A5A5A5A5A5A5ull);
+    ASSERT_EQ(afm_player_init(doc.get(), &po, player_memory.data(), need, &player), AFM_OK);
+  }
+
+  int target(int kind, int number, bool positive = true) const {
+    for (uint32_t i = 0; i < doc->target_count; ++i)
+      if (doc->targets[i].kind == kind && doc->targets[i].number == number &&
+          (doc->targets[i].reference > 0) == positive)
+        return int(i);
+    return -1;
+  }
+
+  uint32_t fdp_vertex(int group, int index) const {
+    for (uint32_t i = 0; i < doc->meta.fdp_count; ++i)
+      if (doc->meta.fdps[i].group == group && doc->meta.fdps[i].index == index) return doc->meta.fdps[i].vertex;
+    return AFM_NONE;
+  }
+
+  const int32_t *pos(uint32_t v) const { return afm_player_positions(player) + 3 * size_t(v); }
+};
+
+Model &head2k() {
+  static Model m(2000);
+  return m;
+}
+
+afm_fap_state state(std::initializer_list<std::pair<int, int32_t>> values) {
+  afm_fap_state s;
+  afm_fap_state_reset(&s);
+  for (auto [f, v] : values) s.value[f] = v;
+  return s;
+}
+
+// A random but plausible state: a dozen FAPs within twice their reference,
+// a viseme blend and an expression, eye and head rotations.
+afm_fap_state random_state(const Model &m, std::mt19937 &rng) {
+  afm_fap_state s;
+  afm_fap_state_reset(&s);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int n = 0; n < 12; ++n) {
+    const afm_target &t = m.doc->targets[rng() % m.doc->target_count];
+    if (t.kind != AFM_TARGET_FAP) continue;
+    s.value[t.number] = int32_t(std::lround(u(rng) * 2 * std::abs(t.reference)));
+  }
+  s.value[3] = int32_t(std::lround((u(rng) + 1) * 600));
+  s.viseme = {uint8_t(1 + rng() % 14), uint8_t(1 + rng() % 14), uint8_t(rng() % 64), 0};
+  s.expression = {uint8_t(1 + rng() % 6), uint8_t(rng() % 64), uint8_t(rng() % 7), uint8_t(rng() % 64), 0, 0};
+  for (int f : {23, 24, 25, 26}) s.value[f] = int32_t(std::lround(u(rng) * 52360));  // +-30 degrees
+  for (int f : {48, 49, 50}) s.value[f] = int32_t(std::lround(u(rng) * 34907));      // +-20 degrees
+  return s;
+}
+
+double angle_between(const afm_q14 *n, const std::array<double, 3> &r) {
+  double a[3] = {n[0] / 16384.0, n[1] / 16384.0, n[2] / 16384.0};
+  double la = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+  double lr = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+  double c = (a[0] * r[0] + a[1] * r[1] + a[2] * r[2]) / (la * lr);
+  return std::acos(std::clamp(c, -1.0, 1.0));
+}
+
+uint64_t fnv1a(uint64_t h, const void *data, size_t n) {
+  const uint8_t *p = static_cast<const uint8_t *>(data);
+  for (size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 1099511628211ull;
+  return h;
+}
+
+// Hash of a pose, serialised little-endian so the value is the same on any host.
+uint64_t pose_hash(const afm_player *p, uint32_t vertices) {
+  uint64_t h = 1469598103934665603ull;
+  const int32_t *x = afm_player_positions(p);
+  const afm_q14 *n = afm_player_normals(p);
+  for (size_t i = 0; i < 3 * size_t(vertices); ++i) {
+    uint8_t b[6] = {uint8_t(x[i]), uint8_t(x[i] >> 8), uint8_t(x[i] >> 16), uint8_t(uint32_t(x[i]) >> 24),
+                    uint8_t(n[i]), uint8_t(uint16_t(n[i]) >> 8)};
+    h = fnv1a(h, b, 6);
+  }
+  return h;
+}
+
+}  // namespace
+
+// ---- fixed point against double ----------------------------------------------------------
+//
+// Error budget per vertex, in quanta (the grid step of the AFM):
+//   weights: each Q12 weight is within 2^-13 of value / reference, so a
+//            target adds at most 2^-13 * max|delta| of error;
+//   positions: one rounding to integer quanta: 0.5;
+//   rigid motion: sin/cos within 1 LSB of Q14 and three rounded Q14 matrix
+//            products: each matrix entry within 4 LSB (2.5e-4), times the
+//            distance to the pivot, for each of at most two nested rigids,
+//            plus 0.5 per rounding of the moved position.
+// The test derives the bound of each vertex from these terms and the data.
+TEST(Player, FixedPointMatchesTheDoubleModelWithinTheStatedBound) {
+  Model &m = head2k();
+  std::mt19937 rng(2024);
+  double worst_error = 0, worst_ratio = 0, worst_normal = 0;
+  for (int trial = 0; trial < 25; ++trial) {
+    afm_fap_state a = random_state(m, rng), b = random_state(m, rng);
+    const double t = (rng() % 65537) / 65536.0;
+    ASSERT_EQ(afm_player_pose(m.player, &a, &b, afm_q16(std::lround(t * 65536))), AFM_OK);
+    afmtest::ReferencePose ref = afmtest::reference_pose(*m.doc, a, b, std::lround(t * 65536) / 65536.0);
+    double morph_budget = 0.5;
+    for (uint32_t i = 0; i < m.doc->target_count; ++i) {
+      if (ref.weights[i] == 0) continue;
+      int32_t md = 0;
+      const afm_target &tg = m.doc->targets[i];
+      for (uint32_t k = 0; k < tg.delta_count; ++k)
+        md = std::max({md, std::abs(int32_t(tg.dx[k])), std::abs(int32_t(tg.dy[k])), std::abs(int32_t(tg.dz[k]))});
+      morph_budget += md / 8192.0;
+    }
+    // Largest distance from any vertex to any pivot, for the rigid term.
+    double reach = 0;
+    const afm_geometry &g = m.doc->geometry;
+    for (uint32_t r = 0; r < m.doc->rigid_count; ++r)
+      for (uint32_t v = 0; v < g.vertex_count; v += 7) {
+        double d = std::hypot(g.px[v] - m.doc->rigids[r].pivot[0], g.py[v] - m.doc->rigids[r].pivot[1],
+                              g.pz[v] - m.doc->rigids[r].pivot[2]);
+        reach = std::max(reach, d + 2 * morph_budget);
+      }
+    const double bound = morph_budget + 2 * (reach * 4 * 3 / 16384.0 + 1.0);
+    const afm_q14 *normals = afm_player_normals(m.player);
+    for (uint32_t v = 0; v < g.vertex_count; ++v) {
+      const int32_t *p = m.pos(v);
+      double e = std::max({std::fabs(p[0] - ref.positions[v][0]), std::fabs(p[1] - ref.positions[v][1]),
+                           std::fabs(p[2] - ref.positions[v][2])});
+      ASSERT_LE(e, bound) << "trial " << trial << " vertex " << v;
+      worst_error = std::max(worst_error, e);
+      worst_ratio = std::max(worst_ratio, e / bound);
+      worst_normal = std::max(worst_normal, angle_between(normals + 3 * size_t(v), ref.normals[v]));
+    }
+  }
+  // Normals: see RecomputedNormalsBeatBlendedNormalDeltas for the bound.
+  EXPECT_LT(worst_normal, 1.5 * M_PI / 180);
+  const double step = m.doc->geometry.step;
+  std::printf("fixed vs double over 25 random poses: worst position error %.2f quanta = %.1f um = "
+              "%.1e of the face's diagonal (%.0f%% of the bound); worst normal error %.3f degrees\n",
+              worst_error, worst_error * step * 1e6, worst_error / m.diagonal_quanta, 100 * worst_ratio,
+              worst_normal * 180 / M_PI);
+  EXPECT_LT(worst_error / m.diagonal_quanta, 1e-4);  // stated in formats/fap.md
+}
+
+// Normals: recomputed (the default) against blended normal deltas, both
+// measured against the double model's recomputed normals. Bound for the
+// default: positions are rounded to half a quantum, and the smallest edges
+// of the 2k head are about 60 quanta, so a face can turn by up to
+// 0.5/60 rad = 0.5 degree, and a vertex normal (a sum of a few faces) by up
+// to about 1 degree; max 1.5 degrees, mean 0.05. The comparison is printed.
+TEST(Player, RecomputedNormalsBeatBlendedNormalDeltas) {
+  static Model with_deltas(2000, 0, true);
+  Model deltas_model(2000, AFM_PLAYER_NORMAL_DELTAS, true);
+  std::mt19937 rng(99);
+  double worst[2] = {0, 0}, mean[2] = {0, 0};
+  size_t count = 0;
+  for (int trial = 0; trial < 15; ++trial) {
+    afm_fap_state s = random_state(with_deltas, rng);
+    for (int f : {23, 24, 25, 26, 48, 49, 50}) s.value[f] = 0;  // morphs only
+    afmtest::ReferencePose ref = afmtest::reference_pose(*with_deltas.doc, s, s, 0);
+    Model *models[2] = {&with_deltas, &deltas_model};
+    for (int m = 0; m < 2; ++m) {
+      ASSERT_EQ(afm_player_pose(models[m]->player, &s, nullptr, 0), AFM_OK);
+      const afm_q14 *n = afm_player_normals(models[m]->player);
+      for (uint32_t v = 0; v < with_deltas.doc->geometry.vertex_count; ++v) {
+        if (!ref.recomputed[v]) continue;
+        double a = angle_between(n + 3 * size_t(v), ref.normals[v]);
+        worst[m] = std::max(worst[m], a);
+        mean[m] += a;
+        if (m == 0) ++count;
+      }
+    }
+  }
+  const double deg = 180 / M_PI;
+  std::printf("normal error against the double model over %zu moved vertices: recomputed mean %.3f "
+              "max %.3f degrees; blended deltas mean %.3f max %.3f degrees\n",
+              count, mean[0] / count * deg, worst[0] * deg, mean[1] / count * deg, worst[1] * deg);
+  EXPECT_LT(worst[0] * deg, 1.5);
+  EXPECT_LT(mean[0] / count * deg, 0.05);
+  EXPECT_LT(mean[0], mean[1]);
+}
+
+// ---- MPEG-4 semantics ------------------------------------------------------------------------
+
+TEST(Player, WeightIsValueOverReference) {
+  Model &m = head2k();
+  afm_fap_state s = state({{3, 512}, {12, -128}, {31, -128}, {33, 100}});
+  ASSERT_EQ(afm_player_pose(m.player, &s, nullptr, 0), AFM_OK);
+  const afm_q12 *w = afm_player_weights(m.player);
+  EXPECT_EQ(w[m.target(AFM_TARGET_FAP, 3)], 2048);          // 512 / 1024
+  EXPECT_EQ(w[m.target(AFM_TARGET_FAP, 12)], -2048);        // -128 / 256: extrapolated, no negative target
+  EXPECT_EQ(w[m.target(AFM_TARGET_FAP, 31, false)], 2048);  // -128 / -256: the negative-side target
+  EXPECT_EQ(w[m.target(AFM_TARGET_FAP, 31, true)], 0);
+  EXPECT_EQ(w[m.target(AFM_TARGET_FAP, 33)], 1600);         // 100 / 256 = 0.390625
+}
+
+TEST(Player, VisemesAndExpressionsBlendBy63rds) {
+  Model &m = head2k();
+  afm_fap_state s = state({});
+  s.viseme = {10, 4, 21, 0};
+  s.expression = {1, 63, 6, 21, 1, 0};
+  ASSERT_EQ(afm_player_pose(m.player, &s, nullptr, 0), AFM_OK);
+  const afm_q12 *w = afm_player_weights(m.player);
+  EXPECT_EQ(w[m.target(AFM_TARGET_VISEME, 10)], std::lround(4096 * 21 / 63.0));
+  EXPECT_EQ(w[m.target(AFM_TARGET_VISEME, 4)], std::lround(4096 * 42 / 63.0));
+  EXPECT_EQ(w[m.target(AFM_TARGET_EXPRESSION, 1)], 4096);
+  EXPECT_EQ(w[m.target(AFM_TARGET_EXPRESSION, 6)], std::lround(4096 * 21 / 63.0));
+}
+
+// A FAP moves its FDP by value x FAPU along its direction (the analytic
+// targets are built so; the player must keep it).
+TEST(Player, FapMovesItsFdpAsTheTableSays) {
+  Model &m = head2k();
+  const afm_meta &meta = m.doc->meta;
+  const double step = m.doc->geometry.step;
+  struct Case {
+    int fap;
+    double fapu;
+  };
+  const Case cases[] = {{3, meta.mns0}, {4, meta.mns0}, {6, meta.mw0}, {19, meta.irisd0}, {31, meta.ens0},
+                        {53, meta.mw0}, {61, meta.ens0}};
+  for (const Case &c : cases) {
+    const afm_fap_info *info = afm_fap(c.fap);
+    uint32_t v = m.fdp_vertex(info->fdp_group, info->fdp_index);
+    ASSERT_NE(v, AFM_NONE) << c.fap;
+    afm_fap_state s = state({{c.fap, 200}});
+    ASSERT_EQ(afm_player_pose(m.player, &s, nullptr, 0), AFM_OK);
+    const int32_t *p = m.pos(v);
+    const afm_geometry &g = m.doc->geometry;
+    double moved[3] = {(p[0] - g.px[v]) * step, (p[1] - g.py[v]) * step, (p[2] - g.pz[v]) * step};
+    double along = moved[0] * info->direction[0] + moved[1] * info->direction[1] + moved[2] * info->direction[2];
+    double expected = 200 * c.fapu / 1024;
+    SCOPED_TRACE(std::string("FAP ") + info->name);
+    // open_jaw rotates the chin: its path is an arc, the drop is exact.
+    EXPECT_NEAR(along, expected, 2 * step);
+  }
+}
+
+TEST(Player, RigidPartsTurnTheWayMpeg4Says) {
+  Model &m = head2k();
+  auto moved = [&](int fap, int32_t value, int group, int index) {
+    uint32_t v = m.fdp_vertex(group, index);
+    EXPECT_NE(v, AFM_NONE);
+    afm_fap_state s = state({{fap, value}});
+    EXPECT_EQ(afm_player_pose(m.player, &s, nullptr, 0), AFM_OK);
+    const afm_geometry &g = m.doc->geometry;
+    const int32_t *p = m.pos(v);
+    return std::array<int32_t, 3>{p[0] - g.px[v], p[1] - g.py[v], p[2] - g.pz[v]};
+  };
+  EXPECT_GT(moved(23, 20000, 3, 5)[0], 0);   // yaw_l_eyeball: the left pupil turns to +x (left)
+  EXPECT_GT(moved(24, 20000, 3, 6)[0], 0);   // yaw_r_eyeball: also "left"
+  EXPECT_LT(moved(25, 20000, 3, 5)[1], 0);   // pitch_l_eyeball: down
+  EXPECT_GT(moved(27, 200, 3, 5)[2], 0);     // thrust_l_eyeball: forward
+  EXPECT_LT(moved(48, 20000, 9, 3)[1], 0);   // head_pitch: the nose tip goes down
+  EXPECT_GT(moved(49, 20000, 9, 3)[0], 0);   // head_yaw: the nose tip turns left
+  EXPECT_LT(moved(50, 20000, 11, 4)[0], 0);  // head_roll: the top of the skull tilts right (-x)
+  EXPECT_LT(moved(3, 512, 2, 1)[1], 0);      // open_jaw: the chin drops
+  EXPECT_LT(moved(15, 200, 2, 1)[0], 0);     // shift_jaw: to the right (-x)
+}
+
+// Morph-only FAPs: blended positions are linear in t. (Rigid ones are not:
+// their angles interpolate, so points move on arcs.)
+TEST(Player, InterpolationHalfwayIsTheAverage) {
+  Model &m = head2k();
+  afm_fap_state a = state({{12, 100}, {6, -50}}), b = state({{12, -200}, {6, 250}});
+  ASSERT_EQ(afm_player_pose(m.player, &a, nullptr, 0), AFM_OK);
+  std::vector<int32_t> pa(afm_player_positions(m.player), afm_player_positions(m.player) + 3 * m.doc->geometry.vertex_count);
+  ASSERT_EQ(afm_player_pose(m.player, &b, nullptr, 0), AFM_OK);
+  std::vector<int32_t> pb(afm_player_positions(m.player), afm_player_positions(m.player) + 3 * m.doc->geometry.vertex_count);
+  ASSERT_EQ(afm_player_pose(m.player, &a, &b, 32768), AFM_OK);
+  const int32_t *pm = afm_player_positions(m.player);
+  int moved = 0;
+  for (size_t i = 0; i < pa.size(); ++i) {
+    EXPECT_NEAR(pm[i], (pa[i] + pb[i]) / 2.0, 1.0) << i;
+    moved += pa[i] != pb[i];
+  }
+  EXPECT_GT(moved, 20);  // the test is not vacuous
+}
+
+TEST(Player, StatePersistsAndMirrorsOnlyWhenAsked) {
+  afm_fap_frame f{};
+  afm_fap_state s;
+  afm_fap_state_reset(&s);
+  f.mask[6] = 1, f.value[6] = 120;  // stretch_l_cornerlip only
+  afm_fap_state_apply(&s, &f, 0);
+  EXPECT_EQ(s.value[6], 120);
+  EXPECT_EQ(s.value[7], 0);
+  afm_fap_frame empty{};
+  afm_fap_state_apply(&s, &empty, 0);
+  EXPECT_EQ(s.value[6], 120);  // not sent: keeps its value
+  afm_fap_state_reset(&s);
+  afm_fap_state_apply(&s, &f, AFM_MIRROR_LEFT_RIGHT);
+  EXPECT_EQ(s.value[7], 120);
+  EXPECT_EQ(s.value[53], 0);
+  afm_fap_state_reset(&s);
+  afm_fap_state_apply(&s, &f, AFM_MIRROR_LEFT_RIGHT | AFM_MIRROR_INNER_OUTER);
+  EXPECT_EQ(s.value[7], 120);
+  EXPECT_EQ(s.value[53], 120);
+  EXPECT_EQ(s.value[54], 120);
+  // Both sides sent: nothing is copied.
+  f.mask[7] = 1, f.value[7] = -30;
+  afm_fap_state_reset(&s);
+  afm_fap_state_apply(&s, &f, AFM_MIRROR_LEFT_RIGHT);
+  EXPECT_EQ(s.value[7], -30);
+}
+
+TEST(Player, CursorAppliesEveryFrameAndInterpolates) {
+  std::vector<afm_fap_frame> frames(5);
+  for (uint32_t i = 0; i < 5; ++i) frames[i].number = i + 1;  // numbered from 1
+  frames[0].mask[3] = 1, frames[0].value[3] = 0;
+  frames[2].mask[5] = 1, frames[2].value[5] = 77;  // only in frame 3
+  frames[3].mask[3] = 1, frames[3].value[3] = 400;
+  afm_fap_cursor c;
+  ASSERT_EQ(afm_fap_cursor_init(&c, frames.data(), 5, 25, 1, 0), AFM_OK);
+  EXPECT_EQ(afm_fap_cursor_duration_us(&c), 160000u);
+  const afm_fap_state *a, *b;
+  afm_q16 t;
+  // Render at 10 fps: 0, 100 ms, 200 ms... frame 3 (80 ms) falls between.
+  ASSERT_EQ(afm_fap_cursor_seek(&c, 0, &a, &b, &t), AFM_OK);
+  EXPECT_EQ(a->value[5], 0);
+  ASSERT_EQ(afm_fap_cursor_seek(&c, 100000, &a, &b, &t), AFM_OK);
+  EXPECT_EQ(a->value[5], 77);  // sent only in frame 3, which no render time hits: still there
+  EXPECT_EQ(a->value[3], 0);   // 100 ms lies between frame 3 (80 ms) and frame 4 (120 ms)
+  EXPECT_EQ(b->value[3], 400);
+  EXPECT_EQ(t, 32768);
+  ASSERT_EQ(afm_fap_cursor_seek(&c, 500000, &a, &b, &t), AFM_OK);  // past the end: the last state
+  EXPECT_EQ(a->value[3], 400);
+  EXPECT_EQ(t, 0);
+  ASSERT_EQ(afm_fap_cursor_seek(&c, 40000, &a, &b, &t), AFM_OK);  // back in time: replayed
+  EXPECT_EQ(a->value[5], 0);
+}
+
+// ---- determinism -----------------------------------------------------------------------------
+
+// Golden per-frame hashes of a synthetic model (integer data only, no
+// generator in the loop). A change here means the player's output changed:
+// if intended, update the values and say why in the commit.
+TEST(Player, GoldenPerFrameHash) {
+  afmtest::SyntheticDoc s;
+  afmtest::SyntheticOptions o;
+  o.rows = 40, o.cols = 50;
+  const afm_doc *src = afmtest::make_synthetic_doc(s, o);
+  std::vector<uint8_t> bytes = afmtest::write_doc(*src, AFM_PROFILE_RAW);
+  afm_doc *d = nullptr;
+  ASSERT_EQ(afm_doc_read_alloc(bytes.data(), bytes.size(), nullptr, nullptr, &d), AFM_OK);
+  std::unique_ptr<afm_doc, DocFree> doc(d);
+  size_t need = 0;
+  ASSERT_EQ(afm_player_measure(d, nullptr, &need), AFM_OK);
+  std::vector<uint64_t> mem(need / 8 + 1, 0x5A5A5A5A5A5A5A5Aull);
+  afm_player *p = nullptr;
+  ASSERT_EQ(afm_player_init(d, nullptr, mem.data(), need, &p), AFM_OK);
+  uint64_t hashes[4];
+  const afm_fap_state states[4] = {state({}), state({{3, 512}, {12, 300}}),
+                                   state({{3, 1500}, {31, -200}, {23, 40000}, {48, -15000}}),
+                                   state({{12, -900}, {31, 400}, {25, 25000}, {27, 300}})};
+  for (int i = 0; i < 4; ++i) {
+    ASSERT_EQ(afm_player_pose(p, &states[i], i ? &states[i - 1] : nullptr, 20000), AFM_OK);
+    hashes[i] = pose_hash(p, d->geometry.vertex_count);
+    std::printf("frame %d hash %016llx\n", i, static_cast<unsigned long long>(hashes[i]));
+  }
+  const uint64_t golden[4] = {0xdfd3734a4d72cc70ull, 0x6e5dd8af9eee03adull, 0xb758474ffc75ddcfull,
+                              0xa865260a27454769ull};
+  for (int i = 0; i < 4; ++i) EXPECT_EQ(hashes[i], golden[i]) << "frame " << i;
+}
+
+// ---- memory --------------------------------------------------------------------------------
+
+TEST(Player, PosingAllocatesNothing) {
+#if !AFM_COUNT_MALLOC
+  GTEST_SKIP() << "malloc is the sanitizer's here; the release build counts";
+#else
+  Model &m = head2k();
+  std::mt19937 rng(7);
+  std::vector<afm_fap_state> states;
+  for (int i = 0; i < 20; ++i) states.push_back(random_state(m, rng));
+  const unsigned long before = g_allocations;
+  for (int i = 1; i < 20; ++i) ASSERT_EQ(afm_player_pose(m.player, &states[i - 1], &states[i], 1000 * i), AFM_OK);
+  EXPECT_EQ(g_allocations - before, 0u);
+  // The counter works: a real allocation is seen.
+  void *probe = malloc(16);
+  EXPECT_EQ(g_allocations - before, 1u);
+  free(probe);
+#endif
+}
