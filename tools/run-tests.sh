@@ -12,6 +12,11 @@ if [ ! -d "$AFM_SHARED_DIR/data" ]; then
   echo "note: $AFM_SHARED_DIR/data is absent: tests that need the shared data files skip"
 fi
 
+# Sanitizer builds: keep LeakSanitizer's list of used suppressions (OSMesa's
+# known leaks) out of the output the tests look at.
+LSAN_OPTIONS="print_suppressions=0${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
+export LSAN_OPTIONS
+
 failed=""
 for t in "$@"; do
   echo "== $t"

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <numeric>
+#include <array>
 
 #include "core/atomic_file.h"
 
@@ -66,7 +68,42 @@ Grid position_grid(const Scene &scene) {
 
 }  // namespace
 
-RenderVertices split_render_vertices(const Scene &scene) {
+std::vector<std::vector<int>> run_friendly_order(const Scene &scene,
+                                                 const std::vector<MorphTarget> &targets,
+                                                 double quantum) {
+  std::vector<std::vector<int>> order(scene.parts.size());
+  for (size_t p = 0; p < scene.parts.size(); ++p) {
+    const size_t V = static_cast<size_t>(scene.parts[p].V.rows());
+    // Targets moving this part, largest first, as membership columns.
+    std::vector<std::vector<char>> columns;
+    std::vector<size_t> sizes;
+    for (const MorphTarget &t : targets) {
+      if (p >= t.displacement.size() || t.displacement[p].rows() != static_cast<Eigen::Index>(V))
+        continue;
+      std::vector<char> moved(V, 0);
+      size_t n = 0;
+      for (size_t v = 0; v < V; ++v)
+        if (t.displacement[p].row(static_cast<Eigen::Index>(v)).cwiseAbs().maxCoeff() >= quantum / 2)
+          moved[v] = 1, ++n;
+      if (n) columns.push_back(std::move(moved)), sizes.push_back(n);
+    }
+    std::vector<size_t> by_size(columns.size());
+    std::iota(by_size.begin(), by_size.end(), size_t{0});
+    std::stable_sort(by_size.begin(), by_size.end(), [&](size_t a, size_t b) { return sizes[a] > sizes[b]; });
+    order[p].resize(V);
+    std::iota(order[p].begin(), order[p].end(), 0);
+    std::stable_sort(order[p].begin(), order[p].end(), [&](int a, int b) {
+      for (size_t c : by_size) {
+        char x = columns[c][static_cast<size_t>(a)], y = columns[c][static_cast<size_t>(b)];
+        if (x != y) return x > y;  // moved vertices first, grouped by signature
+      }
+      return false;
+    });
+  }
+  return order;
+}
+
+RenderVertices split_render_vertices(const Scene &scene, const std::vector<std::vector<int>> *order) {
   RenderVertices rv;
   rv.first.resize(scene.parts.size());
   rv.copies.resize(scene.parts.size());
@@ -77,8 +114,11 @@ RenderVertices split_render_vertices(const Scene &scene) {
     auto &copies = rv.copies[p];
     copies.assign(static_cast<size_t>(part.V.rows()), {});
     const bool split = part.TC.rows() > 0 && part.FTC.rows() == part.F.rows();
+    auto welded = [&](size_t i) {
+      return order ? static_cast<size_t>((*order)[p][i]) : i;
+    };
     if (!split) {
-      for (auto &c : copies) c.push_back(static_cast<uint32_t>(next++));
+      for (size_t i = 0; i < copies.size(); ++i) copies[welded(i)].push_back(static_cast<uint32_t>(next++));
       continue;
     }
     // Distinct texcoords per welded vertex, in order of first use; copies of
@@ -90,7 +130,8 @@ RenderVertices split_render_vertices(const Scene &scene) {
         if (std::find(list.begin(), list.end(), part.FTC(f, k)) == list.end())
           list.push_back(part.FTC(f, k));
       }
-    for (size_t v = 0; v < copies.size(); ++v) {
+    for (size_t i = 0; i < copies.size(); ++i) {
+      const size_t v = welded(i);
       size_t n = std::max<size_t>(1, tcs[v].size());
       for (size_t c = 0; c < n; ++c) copies[v].push_back(static_cast<uint32_t>(next++));
     }
@@ -104,10 +145,12 @@ Expected<std::vector<uint8_t>> encode_afm(const AfmContent &content, afm_profile
   const Scene &scene = *content.scene;
   if (scene.parts.empty()) return Status::error(scene.source + ": the scene has no parts");
   if (scene.parts.size() > 65535) return Status::error(scene.source + ": more than 65535 parts");
-  const RenderVertices rv = split_render_vertices(scene);
+  const Grid grid = position_grid(scene);
+  std::vector<std::vector<int>> order;
+  if (!content.targets.empty()) order = run_friendly_order(scene, content.targets, grid.step);
+  const RenderVertices rv = split_render_vertices(scene, order.empty() ? nullptr : &order);
   if (rv.count > 0xFFFFFFF0u) return Status::error(scene.source + ": too many vertices for AFM");
   const size_t R = rv.count;
-  const Grid grid = position_grid(scene);
 
   bool any_tc = false, any_color = false;
   double umin[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
@@ -220,6 +263,8 @@ Expected<std::vector<uint8_t>> encode_afm(const AfmContent &content, afm_profile
     for (size_t p = 0; p < scene.parts.size() && mt.normals; ++p)
       if (p < mt.displacement.size() && mt.displacement[p].rows() == scene.parts[p].V.rows())
         moved_normals[p] = vertex_normals(scene.parts[p].V + mt.displacement[p], scene.parts[p].F);
+    // Quantised deltas by render vertex, then runs in ascending order.
+    std::vector<std::pair<uint32_t, std::array<int16_t, 6>>> moved;
     for (size_t p = 0; p < scene.parts.size(); ++p) {
       if (p >= mt.displacement.size() || mt.displacement[p].rows() == 0) continue;
       const Eigen::MatrixXd &D = mt.displacement[p];
@@ -227,28 +272,30 @@ Expected<std::vector<uint8_t>> encode_afm(const AfmContent &content, afm_profile
         return Status::error("target " + std::to_string(mt.number) + ": displacement of part '" +
                              scene.parts[p].name + "' is not #V x 3");
       for (Eigen::Index w = 0; w < D.rows(); ++w) {
-        int16_t q[6] = {0, 0, 0, 0, 0, 0};
+        std::array<int16_t, 6> q{};
         for (int k = 0; k < 3; ++k)
-          q[k] = clamp16(std::lround(D(w, k) / static_cast<double>(grid.step)));
+          q[static_cast<size_t>(k)] = clamp16(std::lround(D(w, k) / static_cast<double>(grid.step)));
         if (mt.normals)
           for (int k = 0; k < 3; ++k)
-            q[3 + k] = q14(moved_normals[p](w, k) - normals[p](w, k));
-        if (!q[0] && !q[1] && !q[2] && !q[3] && !q[4] && !q[5]) continue;
-        for (uint32_t r : rv.copies[p][static_cast<size_t>(w)]) {
-          bool extend = !s.runs.empty() && s.runs.back().start + s.runs.back().length == r;
-          bool bridge = !s.runs.empty() && s.runs.back().start + s.runs.back().length + 1 == r;
-          if (bridge) {  // store the one skipped vertex as zeros
-            s.runs.back().length++;
-            for (auto &arr : s.d) arr.push_back(0);
-            extend = true;
-          }
-          if (extend)
-            s.runs.back().length++;
-          else
-            s.runs.push_back({r, 1});
-          for (int k = 0; k < 6; ++k) s.d[k].push_back(q[k]);
-        }
+            q[static_cast<size_t>(3 + k)] = q14(moved_normals[p](w, k) - normals[p](w, k));
+        if (q == std::array<int16_t, 6>{}) continue;
+        for (uint32_t r : rv.copies[p][static_cast<size_t>(w)]) moved.push_back({r, q});
       }
+    }
+    std::sort(moved.begin(), moved.end(), [](const auto &x, const auto &y) { return x.first < y.first; });
+    for (const auto &[r, q] : moved) {
+      bool extend = !s.runs.empty() && s.runs.back().start + s.runs.back().length == r;
+      // A one-vertex gap is cheaper stored as zeros than as a new 8-byte run.
+      if (!extend && !s.runs.empty() && s.runs.back().start + s.runs.back().length + 1 == r) {
+        s.runs.back().length++;
+        for (auto &arr : s.d) arr.push_back(0);
+        extend = true;
+      }
+      if (extend)
+        s.runs.back().length++;
+      else
+        s.runs.push_back({r, 1});
+      for (int k = 0; k < 6; ++k) s.d[k].push_back(q[static_cast<size_t>(k)]);
     }
     afm_target &a = targets[t];
     a.kind = static_cast<uint8_t>(mt.kind);

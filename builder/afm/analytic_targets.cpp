@@ -1,5 +1,8 @@
 #include "afm/analytic_targets.h"
 
+#include "core/fapu.h"
+#include "refhead/refhead.h"
+
 #include <afm/mpeg4.h>
 
 #include <Eigen/Geometry>
@@ -120,9 +123,33 @@ Expected<AnalyticModel> make_analytic_model(const Scene &scene, const FdpSet &fd
     std::vector<double> d = graph.distances(p->vertex, sh.radius);
     Eigen::MatrixXd D = Eigen::MatrixXd::Zero(sk.V.rows(), 3);
     const Eigen::RowVector3d dir = direction_of(info).transpose();
-    for (Eigen::Index v = 0; v < sk.V.rows(); ++v) {
-      double s = d[static_cast<size_t>(v)] / sh.radius;
-      if (s < 1) D.row(v) = amplitude * (1 - s * s) * (1 - s * s) * dir;
+    const int eye = fap >= 19 && fap <= 22
+                        ? scene.find_kind(fap % 2 ? PartKind::EyeLeft : PartKind::EyeRight)
+                        : -1;
+    if (eye >= 0) {
+      // Eyelids slide over the eyeball: turn about its centre (x axis), by
+      // the angle that moves the FDP vertically by exactly the amplitude.
+      const Eigen::Vector3d centre = scene.parts[static_cast<size_t>(eye)].V.colwise().mean().transpose();
+      const double sign = dir.y() < 0 ? 1.0 : -1.0;  // +x turns points in front downwards
+      double lo = 0, hi = 1.5;
+      for (int it = 0; it < 60; ++it) {
+        double mid = 0.5 * (lo + hi);
+        double moved = std::abs(rotate_x(p->pos, centre, sign * mid).y() - p->pos.y());
+        (moved < amplitude ? lo : hi) = mid;
+      }
+      const double angle = sign * 0.5 * (lo + hi);
+      for (Eigen::Index v = 0; v < sk.V.rows(); ++v) {
+        double s = d[static_cast<size_t>(v)] / sh.radius;
+        if (s >= 1) continue;
+        Eigen::Vector3d x = sk.V.row(v).transpose();
+        // The falloff scales the angle, so every vertex stays on its sphere.
+        D.row(v) = (rotate_x(x, centre, angle * (1 - s * s) * (1 - s * s)) - x).transpose();
+      }
+    } else {
+      for (Eigen::Index v = 0; v < sk.V.rows(); ++v) {
+        double s = d[static_cast<size_t>(v)] / sh.radius;
+        if (s < 1) D.row(v) = amplitude * (1 - s * s) * (1 - s * s) * dir;
+      }
     }
     field[fap] = D;
     reference[fap] = sh.reference;
@@ -132,8 +159,17 @@ Expected<AnalyticModel> make_analytic_model(const Scene &scene, const FdpSet &fd
   const FdpPoint *chin = fdp_on(2, 1, skin), *lower_lip = fdp_on(2, 3, skin);
   const FdpPoint *jl = fdp_pos(2, 13), *jr = fdp_pos(2, 14), *el = fdp_pos(10, 7), *er = fdp_pos(10, 8);
   const int teeth_lower = scene.find_kind(PartKind::TeethLower), tongue = scene.find_kind(PartKind::Tongue);
-  if (chin && lower_lip && jl && jr) {
-    Eigen::Vector3d pivot = 0.5 * (jl->pos + jr->pos);
+  const FdpPoint *eye_l = fdp_pos(3, 5), *eye_r = fdp_pos(3, 6);
+  if (chin && lower_lip && ((jl && jr) || (eye_l && eye_r))) {
+    Eigen::Vector3d pivot;
+    if (jl && jr) {
+      pivot = 0.5 * (jl->pos + jr->pos);
+    } else {
+      // No jaw corners (Song has none): a hinge one ENS below the eyes and
+      // 1.2 mouth widths behind the chin, about where the condyles sit.
+      pivot = Eigen::Vector3d(0, 0.5 * (eye_l->pos.y() + eye_r->pos.y()) - fapu.ens0,
+                              chin->pos.z() - 1.2 * fapu.mw0);
+    }
     pivot.x() = 0;
     if (el && er) pivot.y() = 0.5 * (el->pos.y() + er->pos.y());
     // Skin weight: 1 around the chin and lower lip, 0 past the mouth corners,
@@ -300,6 +336,26 @@ Expected<AnalyticModel> make_analytic_model(const Scene &scene, const FdpSet &fd
   }
   model.rigids.push_back(head);
   return model;
+}
+
+Expected<std::vector<uint8_t>> analytic_reference_afm(int skin_vertices, const AnalyticOptions &options,
+                                                      afm_profile profile) {
+  RefHeadOptions ro;
+  ro.skin_vertices = skin_vertices;
+  Expected<RefHead> head = make_reference_head(ro);
+  if (!head) return head.status();
+  Expected<Fapu> fapu = compute_fapu(head->fdps);
+  if (!fapu) return fapu.status();
+  Expected<AnalyticModel> model = make_analytic_model(head->scene, head->fdps, *fapu, options);
+  if (!model) return model.status();
+  AfmContent content;
+  content.scene = &head->scene;
+  content.fdps = &head->fdps;
+  content.fapu = *fapu;
+  content.targets = std::move(model->targets);
+  content.rigids = std::move(model->rigids);
+  content.generator = "analytic_reference_afm";
+  return encode_afm(content, profile);
 }
 
 }  // namespace afmb

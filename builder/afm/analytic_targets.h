@@ -36,4 +36,10 @@ struct AnalyticModel {
 Expected<AnalyticModel> make_analytic_model(const Scene &scene, const FdpSet &fdps,
                                             const Fapu &fapu, const AnalyticOptions &options = {});
 
+// The reference head (refhead.h) at `skin_vertices`, with analytic targets,
+// encoded as an AFM: the model the player's tests and benchmarks use.
+Expected<std::vector<uint8_t>> analytic_reference_afm(int skin_vertices,
+                                                      const AnalyticOptions &options = {},
+                                                      afm_profile profile = AFM_PROFILE_RAW);
+
 }  // namespace afmb

@@ -41,6 +41,9 @@ void usage(FILE *out) {
       "                       the rotation the FDPs imply. Without it, a mesh that is not\n"
       "                       in the MPEG-4 frame is refused with the value to use.\n"
       "  --fdp-format F       auto (default), xfaceed, text or visage\n"
+      "  --flip-v             texture coordinates run downwards in this model (v = 0 at\n"
+      "                       the image's top, as Song's): store 1 - v, so the AFM follows\n"
+      "                       the VRML/OpenGL convention (formats/afm.md)\n"
       "  --profile P          raw (default) or draco (formats/afm.md)\n"
       "  --analytic           add analytic stand-in morph targets (a smooth bump per\n"
       "                       FAP that moves its FDP exactly as MPEG-4 says; visemes,\n"
@@ -65,7 +68,7 @@ int main(int argc, char **argv) {
   std::string mesh_path, fdp_path, out_path, orient_spec;
   FdpFormat fdp_format = FdpFormat::Auto;
   afm_profile profile = AFM_PROFILE_RAW;
-  bool list_fdps = false, analytic = false, normal_deltas = false;
+  bool list_fdps = false, analytic = false, normal_deltas = false, flip_v = false;
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
     auto value = [&](const char *name) -> const char * {
@@ -102,6 +105,8 @@ int main(int argc, char **argv) {
       }
     } else if (a == "--fdps") {
       list_fdps = true;
+    } else if (a == "--flip-v") {
+      flip_v = true;
     } else if (a == "--analytic") {
       analytic = true;
     } else if (a == "--normal-deltas") {
@@ -125,6 +130,9 @@ int main(int argc, char **argv) {
 
   Expected<Scene> scene = read_scene(mesh_path);
   if (!scene) return fail(scene.status());
+  if (flip_v)
+    for (Part &p : scene->parts)
+      if (p.TC.rows()) p.TC.col(1) = (1.0 - p.TC.col(1).array()).matrix();
   Expected<FdpSet> fdps = read_fdp(fdp_path, fdp_format);
   if (!fdps) return fail(fdps.status());
   if (Status s = bind_fdps(*fdps, *scene); !s) return fail(s);

@@ -67,6 +67,26 @@ afm_result afm_fail(afm_reader *r, afm_result result, const char *format, ...) {
   return result;
 }
 
+/* ---- float bit checks ------------------------------------------------------- */
+
+static uint32_t f32_bits(float f) {
+  uint32_t u;
+  memcpy(&u, &f, sizeof u);
+  return u;
+}
+
+int afm_f32_finite(float f) { return ((f32_bits(f) >> 23) & 0xFFu) != 0xFFu; }
+
+int afm_f32_nonnegative(float f) {
+  uint32_t u = f32_bits(f);
+  return afm_f32_finite(f) && (!(u >> 31) || (u & 0x7FFFFFFFu) == 0);
+}
+
+int afm_f32_positive(float f) {
+  uint32_t u = f32_bits(f);
+  return afm_f32_finite(f) && !(u >> 31) && (u & 0x7FFFFFFFu) != 0;
+}
+
 /* ---- little-endian -------------------------------------------------------- */
 
 uint16_t afm_load_u16(const uint8_t *p) { return (uint16_t)(p[0] | (p[1] << 8)); }

@@ -1,5 +1,4 @@
 /* GEOM chunk: neutral mesh with named parts (formats/afm.md). */
-#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -10,7 +9,7 @@ enum { kPartFixedSize = 24 };
 static int finite_all(const float *v, int n) {
   int i;
   for (i = 0; i < n; ++i)
-    if (!isfinite(v[i])) return 0;
+    if (!afm_f32_finite(v[i])) return 0;
   return 1;
 }
 
@@ -130,7 +129,7 @@ static afm_result decode_header(afm_reader *r, afm_arena *arena, afm_geometry *g
     return afm_fail(r, AFM_ERR_RANGE, "attributes 0x%x has unknown bits",
                     (unsigned)g->attributes);
   if (g->part_count == 0) return afm_fail(r, AFM_ERR_RANGE, "part_count is 0");
-  if (!finite_all(g->origin, 3) || !(g->step > 0.0f) || !isfinite(g->step) ||
+  if (!finite_all(g->origin, 3) || !afm_f32_positive(g->step) ||
       !finite_all(g->uv_origin, 2) || !finite_all(g->uv_step, 2))
     return afm_fail(r, AFM_ERR_RANGE, "quantisation: origin/step not finite or step <= 0");
   if (g->part_count > afm_remaining(r) / (kPartFixedSize + 8))

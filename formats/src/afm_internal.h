@@ -96,6 +96,12 @@ uint32_t afm_load_u32(const uint8_t *p);
 void afm_store_u16(uint8_t *p, uint16_t v);
 void afm_store_u32(uint8_t *p, uint32_t v);
 
+/* IEEE-754 binary32 checks on the bits alone: no floating-point arithmetic,
+ * so a core built for a CPU without an FPU calls no soft-float helper. */
+int afm_f32_finite(float f);
+int afm_f32_nonnegative(float f); /* finite, +0 or positive (-0 counts as 0) */
+int afm_f32_positive(float f);    /* finite and > 0 */
+
 /* "GEOM" for a fourcc; non-printable bytes as '?'. */
 void afm_fourcc_text(uint32_t kind, char out[5]);
 

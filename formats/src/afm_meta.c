@@ -1,5 +1,4 @@
 /* META chunk: model name, units, generator, FAPU, FDP positions. */
-#include <math.h>
 #include <string.h>
 
 #include "afm_internal.h"
@@ -18,7 +17,7 @@ afm_result afm_meta_decode(const uint8_t *raw, size_t size, uint64_t file_offset
   meta->fdp_count = afm_read_u32(&r, "fdp_count");
   for (i = 0; i < 5; ++i) {
     fapu[i] = afm_read_f32(&r, "fapu");
-    if (r.error == AFM_OK && !(fapu[i] >= 0.0f && isfinite(fapu[i])))
+    if (r.error == AFM_OK && !afm_f32_nonnegative(fapu[i]))
       return afm_fail(&r, AFM_ERR_RANGE, "fapu[%u] is negative or not finite", (unsigned)i);
   }
   meta->es0 = fapu[0];
@@ -44,7 +43,7 @@ afm_result afm_meta_decode(const uint8_t *raw, size_t size, uint64_t file_offset
     p.vertex = afm_read_u32(&r, "fdp.vertex");
     for (k = 0; k < 3; ++k) {
       p.pos[k] = afm_read_f32(&r, "fdp.pos");
-      if (r.error == AFM_OK && !isfinite(p.pos[k]))
+      if (r.error == AFM_OK && !afm_f32_finite(p.pos[k]))
         return afm_fail(&r, AFM_ERR_RANGE, "fdp %u.%u: position not finite", p.group, p.index);
     }
     if (r.error == AFM_OK && (p.group < 2 || p.group > 11 || p.index < 1 || p.index > 15))

@@ -141,19 +141,22 @@ void afm_add_restore_span(afm_player *p, uint32_t start, uint32_t end) {
   }
 }
 
-void afm_restore_outputs(afm_player *p) {
+void afm_neutral_outputs(afm_player *p, uint32_t start, uint32_t end) {
   const afm_geometry *g = &p->doc->geometry;
-  uint32_t i, v;
-  for (i = 0; i < p->restore_count; ++i) {
-    for (v = p->restore[i].start; v < p->restore[i].end; ++v) {
-      int32_t *o = p->positions + 3 * (size_t)v;
-      afm_q14 *n = p->normals + 3 * (size_t)v;
-      o[0] = g->px[v], o[1] = g->py[v], o[2] = g->pz[v];
-      if (g->nx)
-        n[0] = g->nx[v], n[1] = g->ny[v], n[2] = g->nz[v];
-      else
-        n[0] = n[1] = 0, n[2] = AFM_Q14_ONE;
-    }
+  uint32_t v;
+  for (v = start; v < end; ++v) {
+    int32_t *o = p->positions + 3 * (size_t)v;
+    afm_q14 *n = p->normals + 3 * (size_t)v;
+    o[0] = g->px[v], o[1] = g->py[v], o[2] = g->pz[v];
+    if (g->nx)
+      n[0] = g->nx[v], n[1] = g->ny[v], n[2] = g->nz[v];
+    else
+      n[0] = n[1] = 0, n[2] = AFM_Q14_ONE;
   }
+}
+
+void afm_restore_outputs(afm_player *p) {
+  uint32_t i;
+  for (i = 0; i < p->restore_count; ++i) afm_neutral_outputs(p, p->restore[i].start, p->restore[i].end);
   p->restore_count = 0;
 }

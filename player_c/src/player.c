@@ -84,7 +84,6 @@ afm_result afm_player_init(const afm_doc *doc, const afm_player_options *options
   uint32_t flags = options ? options->flags : 0;
   afm_player *p;
   size_t need;
-  uint32_t i;
   afm_result r = afm_player_measure(doc, options, &need);
   if (r != AFM_OK) return r;
   if (!buffer || !out || ((uintptr_t)buffer & 7u)) return AFM_ERR_ARGUMENT;
@@ -101,17 +100,7 @@ afm_result afm_player_init(const afm_doc *doc, const afm_player_options *options
   afm_weights_init(p);
   memset(p->moved, 0, p->vertex_count); /* the caller's buffer may hold anything */
   if (recomputes_normals(flags)) afm_normals_init(p);
-  /* Neutral outputs and accumulators. */
-  for (i = 0; i < p->vertex_count; ++i) {
-    const afm_geometry *g = &doc->geometry;
-    int32_t *o = p->positions + 3 * (size_t)i;
-    afm_q14 *n = p->normals + 3 * (size_t)i;
-    o[0] = g->px[i], o[1] = g->py[i], o[2] = g->pz[i];
-    if (g->nx)
-      n[0] = g->nx[i], n[1] = g->ny[i], n[2] = g->nz[i];
-    else
-      n[0] = n[1] = 0, n[2] = AFM_Q14_ONE;
-  }
+  afm_neutral_outputs(p, 0, p->vertex_count);
   afm_blend_reset(p, kWeightBits);
   *out = p;
   return afm_player_pose(p, NULL, NULL, 0);

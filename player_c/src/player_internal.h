@@ -10,6 +10,10 @@
 
 #include "afm/player.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* A half-open vertex range [start, end). */
 typedef struct afm_span {
   uint32_t start, end;
@@ -72,6 +76,7 @@ void afm_blend_reset(afm_player *p, int shift);
 void afm_blend_restore(afm_player *p);
 void afm_blend_targets(afm_player *p, int shift);
 void afm_blend_output(afm_player *p, int shift);
+void afm_neutral_outputs(afm_player *p, uint32_t start, uint32_t end);
 void afm_restore_outputs(afm_player *p);
 void afm_add_restore_span(afm_player *p, uint32_t start, uint32_t end);
 
@@ -84,5 +89,9 @@ void afm_normalize_q14(int64_t x, int64_t y, int64_t z, afm_q14 out[3]);
 /* rigid.c */
 afm_result afm_rigids_check(const afm_doc *doc);
 void afm_rigids_apply(afm_player *p, const afm_fap_state *a, const afm_fap_state *b, afm_q16 t);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* AFM_PLAYER_INTERNAL_H */

@@ -2,18 +2,9 @@
 # afm-headgen: the files it writes (VRML or OBJ by extension, the FDP file
 # beside it, a PNG picture), and its errors (bad usage exits 2 with a clear
 # message and writes nothing; an unwritable place exits 1).
-set -u
-: "${AFM_BUILD:=build}"
-bin="$AFM_BUILD/bin/afm-headgen"
-tmp="$AFM_BUILD/test-output/cli-headgen"
-rm -rf "$tmp"
-mkdir -p "$tmp"
-failures=0
-
-fail() {
-  echo "FAIL: $*"
-  failures=$((failures + 1))
-}
+test_name=test_headgen.sh
+. "$(dirname "$0")/lib/common.sh"
+bin="$bin/afm-headgen"
 
 # Default format and FDP name: OUT.wrl and OUT.fdp.
 "$bin" --vertices 1000 -o "$tmp/a.wrl" >"$tmp/out.txt" 2>&1 || fail "a plain run failed"
@@ -60,8 +51,4 @@ check_usage "bad views" "YAW or YAW:PITCH" -o "$tmp/bad.wrl" --render "$tmp/x.pn
 grep -q "no/such/dir/c.wrl" "$tmp/err.txt" || fail "unwritable output: '$(cat "$tmp/err.txt")'"
 ls "$tmp"/*.tmp* >/dev/null 2>&1 && fail "left a temporary file"
 
-if [ "$failures" -ne 0 ]; then
-  echo "test_headgen.sh: $failures failure(s)"
-  exit 1
-fi
-echo "test_headgen.sh: all passed"
+finish

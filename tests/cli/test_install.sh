@@ -9,13 +9,18 @@ tmp="$top/$AFM_BUILD/test-output/cli-install"
 rm -rf "$tmp"
 mkdir -p "$tmp"
 cd "$top" || exit 1
-case "$AFM_BUILD" in
-  build) config=release ;;
-  build/*) config=${AFM_BUILD#build/} ;;
-  *) echo "test_install.sh: unknown build directory $AFM_BUILD"; exit 1 ;;
-esac
+# The Makefile passes its config; by hand, the default build directories tell it.
+config=${AFM_CONFIG:-}
+if [ -z "$config" ]; then
+  case "$AFM_BUILD" in
+    build) config=release ;;
+    build/debug | build/sanitize) config=${AFM_BUILD#build/} ;;
+    *) echo "test_install.sh: set AFM_CONFIG for the build directory $AFM_BUILD"; exit 1 ;;
+  esac
+fi
 
-if ! make --no-print-directory -s install config="$config" PREFIX="$tmp/prefix" >"$tmp/install.log" 2>&1; then
+if ! make --no-print-directory -s install config="$config" B="$AFM_BUILD" PREFIX="$tmp/prefix" \
+    >"$tmp/install.log" 2>&1; then
   echo "FAIL: make install"; cat "$tmp/install.log"; exit 1
 fi
 for f in bin/afm-info bin/afm-import include/afm/format.h include/afm/draco.h \

@@ -2,40 +2,8 @@
 # Command-line behaviour of the tools: --help, bad input (a clear message that
 # names the file and line, part or FDP; exit 1; no output file, and an
 # existing output left untouched), and the raw <-> draco round trip.
-set -u
-: "${AFM_BUILD:=build}"
-bin="$AFM_BUILD/bin"
-tmp="$AFM_BUILD/test-output/cli-tools"
-rm -rf "$tmp"
-mkdir -p "$tmp"
-failures=0
-
-fail() {
-  echo "FAIL: $*"
-  failures=$((failures + 1))
-}
-
-# expect_error NAME STATUS PATTERN OUTPUT -- COMMAND...: the command exits with
-# STATUS, its stderr matches PATTERN (grep -E), and OUTPUT does not exist.
-expect_error() {
-  name=$1 status=$2 pattern=$3 output=$4
-  shift 5
-  "$@" >"$tmp/out.txt" 2>"$tmp/err.txt"
-  got=$?
-  if [ "$got" -ne "$status" ]; then
-    fail "$name: exit $got, expected $status"
-    sed 's/^/    /' "$tmp/err.txt"
-  elif ! grep -Eq -- "$pattern" "$tmp/err.txt"; then
-    fail "$name: message does not match '$pattern':"
-    sed 's/^/    /' "$tmp/err.txt"
-  fi
-  if [ "$output" != "-" ] && [ -e "$output" ]; then
-    fail "$name: left $output behind"
-  fi
-  if ls "$tmp"/*.tmp* >/dev/null 2>&1; then
-    fail "$name: left a temporary file: $(ls "$tmp"/*.tmp*)"
-  fi
-}
+test_name=test_tools.sh
+. "$(dirname "$0")/lib/common.sh"
 
 for t in afm-headgen afm-import afm-info afm-pack; do
   "$bin/$t" --help >"$tmp/help.txt" 2>&1 || fail "$t --help exits non-zero"
@@ -124,8 +92,4 @@ cmp -s "$tmp/head.afm" "$tmp/head-raw.afm" || fail "raw -> draco -> raw changed 
 grep -q "GEOM  draco" "$tmp/info.txt" || fail "afm-info does not show the draco GEOM chunk"
 grep -q "skin .*skin" "$tmp/info.txt" || fail "afm-info does not list the skin part"
 
-if [ "$failures" -ne 0 ]; then
-  echo "test_tools.sh: $failures failures"
-  exit 1
-fi
-echo "test_tools.sh: all passed"
+finish

@@ -14,11 +14,8 @@
 #include <random>
 
 #include "../common/synthetic_doc.h"
-#include "afm/afm_export.h"
 #include "afm/analytic_targets.h"
-#include "core/fapu.h"
 #include "reference_player.h"
-#include "refhead/refhead.h"
 
 // ---- a counting malloc -------------------------------------------------------------
 // The test binary interposes malloc to count calls made while posing. Under
@@ -69,22 +66,9 @@ struct Model {
   double diagonal_quanta = 0;  // bounding-box diagonal of the neutral mesh
 
   explicit Model(int skin_vertices, uint32_t player_flags = 0, bool normal_deltas = false) {
-    afmb::RefHeadOptions ro;
-    ro.skin_vertices = skin_vertices;
-    afmb::Expected<afmb::RefHead> head = afmb::make_reference_head(ro);
-    EXPECT_TRUE(head.is_ok());
-    afmb::Expected<afmb::Fapu> fapu = afmb::compute_fapu(head->fdps);
     afmb::AnalyticOptions ao;
     ao.normal_deltas = normal_deltas;
-    afmb::Expected<afmb::AnalyticModel> am = afmb::make_analytic_model(head->scene, head->fdps, *fapu, ao);
-    EXPECT_TRUE(am.is_ok());
-    afmb::AfmContent content;
-    content.scene = &head->scene;
-    content.fdps = &head->fdps;
-    content.fapu = *fapu;
-    content.targets = am->targets;
-    content.rigids = am->rigids;
-    afmb::Expected<std::vector<uint8_t>> bytes = afmb::encode_afm(content, AFM_PROFILE_RAW);
+    afmb::Expected<std::vector<uint8_t>> bytes = afmb::analytic_reference_afm(skin_vertices, ao);
     EXPECT_TRUE(bytes.is_ok()) << bytes.status().message();
     afm_doc *d = nullptr;
     afm_read_options opt{};

@@ -43,6 +43,9 @@ static int encode(FILE *f, const afm_render_image *image, png_bytep *rows) {
   png_set_IHDR(png, info, (png_uint_32)image->width, (png_uint_32)image->height, 8,
                PNG_COLOR_TYPE_RGBA, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
                PNG_FILTER_TYPE_DEFAULT);
+  /* zlib level 3: about three times faster than the default (6) on rendered
+   * frames, for files some 15 % larger; animations write many. */
+  png_set_compression_level(png, 3);
   png_write_info(png, info);
   png_write_image(png, rows);
   png_write_end(png, NULL);

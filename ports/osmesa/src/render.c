@@ -16,13 +16,28 @@
 #define MAX_SIZE 8192
 #define PI_F 3.14159265358979323846f
 
+struct tex_entry {
+  const uint8_t *src;
+  int w, h;
+  GLuint name;
+  unsigned long used;  /* the call that last bound it */
+  int kept;            /* uploaded as static: valid across calls */
+};
+
+#define TEX_KEEP 64 /* entries beyond this are recycled when not in use */
+
 struct afm_renderer {
   OSMesaContext ctx;
   uint8_t *buffer; /* (width * s) x (height * s) RGBA, bottom row first */
   int buf_w, buf_h;
   GLuint program;
-  GLint u_lit, u_tex, u_sampler, u_bias, u_ortho, u_back;
-  GLuint texture;
+  GLint u_lit, u_tex, u_sampler, u_bias, u_ortho, u_back, u_cut;
+  /* Texture objects, one per distinct image (pixels pointer and size): an
+   * image that several meshes share is uploaded once per frame, or once for
+   * the renderer's life when its mesh says texture_static. */
+  struct tex_entry *tex;
+  size_t tex_count, tex_cap;
+  unsigned long call; /* afm_renderer_draw calls so far */
   float *normals; /* scratch for computed normals */
   size_t normals_cap;
 };
@@ -58,6 +73,7 @@ static const char *const fragment_src =
     "uniform int u_tex;\n"
     "uniform int u_ortho;\n"
     "uniform float u_back;\n"
+    "uniform float u_cut;\n"
     "uniform sampler2D u_sampler;\n"
     "varying vec3 v_n;\n"
     "varying vec3 v_p;\n"
@@ -66,6 +82,7 @@ static const char *const fragment_src =
     "void main() {\n"
     "  vec4 base = v_c;\n"
     "  if (u_tex != 0) base *= texture2D(u_sampler, v_uv);\n"
+    "  if (base.a < u_cut) discard;\n"
     "  if (u_lit == 0) { gl_FragColor = base; return; }\n"
     "  vec3 n = normalize(v_n);\n"
     "  vec3 v = u_ortho != 0 ? vec3(0.0, 0.0, 1.0) : normalize(-v_p);\n"
@@ -128,6 +145,7 @@ static afm_result build_program(afm_renderer *r) {
   r->u_bias = glGetUniformLocation(prog, "u_bias");
   r->u_ortho = glGetUniformLocation(prog, "u_ortho");
   r->u_back = glGetUniformLocation(prog, "u_back");
+  r->u_cut = glGetUniformLocation(prog, "u_cut");
   return AFM_OK;
 }
 
@@ -169,6 +187,7 @@ void afm_renderer_destroy(afm_renderer *r) {
    * the context and go with it. */
   if (OSMesaGetCurrentContext() == r->ctx) OSMesaMakeCurrent(NULL, NULL, GL_UNSIGNED_BYTE, 0, 0);
   OSMesaDestroyContext(r->ctx);
+  free(r->tex);
   free(r->buffer);
   free(r->normals);
   free(r);
@@ -383,6 +402,58 @@ static afm_result ensure_buffer(afm_renderer *r, int w, int h) {
   return AFM_OK;
 }
 
+/* Binds the texture object holding `tex`, uploading it unless this call
+ * already did, or it is static and was uploaded as static before. */
+static afm_result bind_texture(afm_renderer *r, const afm_render_image *tex, int is_static) {
+  size_t i, pick = (size_t)-1;
+  struct tex_entry *e;
+  for (i = 0; i < r->tex_count; ++i)
+    if (r->tex[i].src == tex->rgba && r->tex[i].w == tex->width && r->tex[i].h == tex->height) break;
+  if (i < r->tex_count) {
+    e = &r->tex[i];
+    glBindTexture(GL_TEXTURE_2D, e->name);
+    if (e->used == r->call || (is_static && e->kept)) {
+      e->used = r->call;
+      return AFM_OK;
+    }
+  } else {
+    /* A new image: recycle the least recently used entry not bound in this
+     * call once there are many, else add one. */
+    if (r->tex_count >= TEX_KEEP)
+      for (i = 0; i < r->tex_count; ++i)
+        if (r->tex[i].used != r->call && (pick == (size_t)-1 || r->tex[i].used < r->tex[pick].used))
+          pick = i;
+    if (pick == (size_t)-1) {
+      if (r->tex_count == r->tex_cap) {
+        size_t cap = r->tex_cap ? 2 * r->tex_cap : 8;
+        struct tex_entry *t = (struct tex_entry *)realloc(r->tex, cap * sizeof *t);
+        if (!t) return render_fail(AFM_ERR_OUT_OF_MEMORY, "out of memory for %zu textures", cap);
+        r->tex = t;
+        r->tex_cap = cap;
+      }
+      pick = r->tex_count++;
+      memset(&r->tex[pick], 0, sizeof r->tex[pick]);
+      glGenTextures(1, &r->tex[pick].name);
+    }
+    e = &r->tex[pick];
+    e->src = tex->rgba;
+    e->w = tex->width;
+    e->h = tex->height;
+    glBindTexture(GL_TEXTURE_2D, e->name);
+  }
+  e->used = r->call;
+  e->kept = is_static;
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA, tex->width, tex->height, 0, GL_RGBA, GL_UNSIGNED_BYTE,
+               tex->rgba);
+  glGenerateMipmap(GL_TEXTURE_2D);
+  return AFM_OK;
+}
+
 static void set_color_state(const afm_render_mesh *m) {
   if (m->colors) {
     glEnableClientState(GL_COLOR_ARRAY);
@@ -401,6 +472,7 @@ static afm_result draw_mesh(afm_renderer *r, const afm_render_mesh *m, const afm
   int textured = m->texture && m->uvs && m->triangles;
   int lit = !m->unlit && m->triangles;
   glUniform1f(r->u_bias, m->depth_bias);
+  glUniform1f(r->u_cut, m->alpha_cutoff);
   glEnableClientState(GL_VERTEX_ARRAY);
   glVertexPointer(3, GL_FLOAT, 0, m->positions);
   set_color_state(m);
@@ -426,17 +498,10 @@ static afm_result draw_mesh(afm_renderer *r, const afm_render_mesh *m, const afm
     glNormalPointer(GL_FLOAT, 0, normals);
   }
   if (textured) {
-    const afm_render_image *tex = m->texture;
-    if (!r->texture) glGenTextures(1, &r->texture);
+    afm_result res;
     glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D, r->texture);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA, tex->width, tex->height, 0, GL_RGBA,
-                 GL_UNSIGNED_BYTE, tex->rgba);
+    res = bind_texture(r, m->texture, m->texture_static);
+    if (res != AFM_OK) return res;
     glEnableClientState(GL_TEXTURE_COORD_ARRAY);
     glTexCoordPointer(2, GL_FLOAT, 0, m->uvs);
     glUniform1i(r->u_sampler, 0);
@@ -524,6 +589,7 @@ afm_result afm_renderer_draw(afm_renderer *r, const afm_render_mesh *meshes, siz
       bmax[k] = 1.0f;
     }
   }
+  r->call++;
   res = ensure_buffer(r, view->width * s, view->height * s);
   if (res != AFM_OK) return res;
   setup_camera(view, bmin, bmax, &cam);

@@ -58,6 +58,10 @@ typedef struct afm_render_mesh {
   const uint8_t *colors;      /* vertex_count x 4 RGBA8, or NULL: `color` */
   const float *uvs;           /* vertex_count x 2 (per vertex, v up), or NULL */
   const afm_render_image *texture; /* modulates the colour when uvs are given */
+  int texture_static;         /* non-zero: the texture's pixels stay as they are
+                                 for the renderer's life (while this pointer and
+                                 size are used), so an afm_renderer uploads them
+                                 once instead of at every draw */
   float color[4];             /* material RGBA in [0,1] used when colors is NULL;
                                  all zero means light grey */
   int wireframe;              /* non-zero: draw the triangle edges over the faces */
@@ -66,6 +70,10 @@ typedef struct afm_render_mesh {
   float depth_bias;           /* pulls the mesh toward the viewer by this many
                                  model units, so markers lying on a surface are
                                  not hidden by it; 0 for ordinary meshes */
+  float alpha_cutoff;         /* pixels whose alpha (colour times texture) is
+                                 below this are not drawn: cut-out textures such
+                                 as hair strands and lashes; 0 draws every pixel
+                                 (alpha is otherwise ignored: no blending) */
 } afm_render_mesh;
 
 /* Where the camera is and what the image looks like. Zero-initialise, then

@@ -1,0 +1,50 @@
+# Sourced by the command-line tests (tests/cli/*.sh). Before sourcing, set
+# test_name (it names the output directory and the verdict line). Gives:
+#   bin, tmp          $AFM_BUILD/bin, and a fresh $AFM_BUILD/test-output/<test_name>
+#   fail MESSAGE      counts a failure
+#   expect_error NAME STATUS PATTERN OUTPUT -- COMMAND...
+#                     the command exits with STATUS, its stderr matches PATTERN
+#                     (grep -E), OUTPUT ('-' for none) does not exist, and no
+#                     temporary file is left in $tmp
+#   finish [NOTE]     prints the verdict and exits 0 or 1
+set -u
+: "${AFM_BUILD:=build}"
+bin="$AFM_BUILD/bin"
+tmp="$AFM_BUILD/test-output/$test_name"
+rm -rf "$tmp"
+mkdir -p "$tmp"
+failures=0
+
+fail() {
+  echo "FAIL: $*"
+  failures=$((failures + 1))
+}
+
+expect_error() {
+  name=$1 status=$2 pattern=$3 output=$4
+  shift 5
+  "$@" >"$tmp/out.txt" 2>"$tmp/err.txt"
+  got=$?
+  if [ "$got" -ne "$status" ]; then
+    fail "$name: exit $got, expected $status"
+    sed 's/^/    /' "$tmp/err.txt"
+  elif ! grep -Eq -- "$pattern" "$tmp/err.txt"; then
+    fail "$name: message does not match '$pattern':"
+    sed 's/^/    /' "$tmp/err.txt"
+  fi
+  if [ "$output" != "-" ] && [ -e "$output" ]; then
+    fail "$name: left $output behind"
+  fi
+  if find "$tmp" -name '*.tmp*' | grep -q .; then
+    fail "$name: left a temporary file: $(find "$tmp" -name '*.tmp*')"
+  fi
+}
+
+finish() {
+  if [ "$failures" -ne 0 ]; then
+    echo "$test_name: $failures failure(s)"
+    exit 1
+  fi
+  echo "$test_name: all passed${1:+ ($1)}"
+  exit 0
+}
