@@ -70,20 +70,38 @@ Timing time_fixed(const afm_doc &doc, uint32_t flags, const std::vector<afm_fap_
   return {elapsed / n, updates / n};
 }
 
-// Every target's deltas in model units, planar x[], y[], z[]: the float side.
-std::vector<std::vector<float>> float_deltas(const afm_doc &doc) {
-  std::vector<std::vector<float>> d(doc.target_count);
-  for (uint32_t t = 0; t < doc.target_count; ++t) {
-    const afm_target &tg = doc.targets[t];
-    d[t].resize(3 * size_t(tg.delta_count));
-    for (uint32_t k = 0; k < tg.delta_count; ++k) {
-      d[t][k] = tg.dx[k] * doc.geometry.step;
-      d[t][tg.delta_count + k] = tg.dy[k] * doc.geometry.step;
-      d[t][2 * size_t(tg.delta_count) + k] = tg.dz[k] * doc.geometry.step;
+// The float side: every positive FAP target's deltas in model units (planar
+// x[], y[], z[]), and w * delta added over a target's runs.
+struct FloatModel {
+  std::vector<std::vector<float>> d;  // per target
+  std::vector<int> target_of;         // FAP -> target, or -1
+
+  explicit FloatModel(const afm_doc &doc) : d(doc.target_count), target_of(AFM_FAP_COUNT + 1, -1) {
+    for (uint32_t t = 0; t < doc.target_count; ++t) {
+      const afm_target &tg = doc.targets[t];
+      d[t].resize(3 * size_t(tg.delta_count));
+      for (uint32_t k = 0; k < tg.delta_count; ++k) {
+        d[t][k] = tg.dx[k] * doc.geometry.step;
+        d[t][tg.delta_count + k] = tg.dy[k] * doc.geometry.step;
+        d[t][2 * size_t(tg.delta_count) + k] = tg.dz[k] * doc.geometry.step;
+      }
+      if (tg.kind == AFM_TARGET_FAP && tg.reference > 0) target_of[tg.number] = int(t);
     }
   }
-  return d;
-}
+
+  void blend(const afm_target &tg, int t, float w, float *ax, float *ay, float *az) const {
+    const float *dx = d[size_t(t)].data(), *dy = dx + tg.delta_count, *dz = dy + tg.delta_count;
+    uint32_t k = 0;
+    for (uint32_t r = 0; r < tg.run_count; ++r) {
+      const uint32_t st = tg.runs[r].start, len = tg.runs[r].length;
+      float *a = ax + st, *b = ay + st, *c = az + st;
+      for (uint32_t i = 0; i < len; ++i) a[i] += w * dx[k + i];
+      for (uint32_t i = 0; i < len; ++i) b[i] += w * dy[k + i];
+      for (uint32_t i = 0; i < len; ++i) c[i] += w * dz[k + i];
+      k += len;
+    }
+  }
+};
 
 // The blend stage alone (afm_blend_targets: every active target's runs
 // multiply-added into the accumulators, and the moved spans found), on the
@@ -116,32 +134,18 @@ Timing time_fixed_kernel(const afm_doc &doc, const std::vector<afm_fap_state> &s
 // The same multiply-adds in float over the same runs (deltas in model units).
 Timing time_float_kernel(const afm_doc &doc, const std::vector<afm_fap_state> &states) {
   const size_t V = doc.geometry.vertex_count;
-  const std::vector<std::vector<float>> d = float_deltas(doc);
+  const FloatModel m(doc);
   std::vector<float> acc(3 * V, 0.0f);
-  std::vector<int> target_of(AFM_FAP_COUNT + 1, -1);
-  for (uint32_t t = 0; t < doc.target_count; ++t)
-    if (doc.targets[t].kind == AFM_TARGET_FAP && doc.targets[t].reference > 0)
-      target_of[doc.targets[t].number] = int(t);
   double seconds = 0, updates = 0;
   int n = 0;
   while (seconds < 1.0) {
     for (const afm_fap_state &s : states) {
       auto t0 = Clock::now();
       for (int f = 3; f <= AFM_FAP_COUNT; ++f) {
-        int t = target_of[size_t(f)];
+        int t = m.target_of[size_t(f)];
         if (!s.value[f] || t < 0) continue;
         const afm_target &tg = doc.targets[t];
-        const float w = float(s.value[f]) / float(tg.reference);
-        const float *dx = d[size_t(t)].data(), *dy = dx + tg.delta_count, *dz = dy + tg.delta_count;
-        uint32_t k = 0;
-        for (uint32_t r = 0; r < tg.run_count; ++r) {
-          const uint32_t st = tg.runs[r].start, len = tg.runs[r].length;
-          float *a = &acc[st], *b = &acc[V + st], *c = &acc[2 * V + st];
-          for (uint32_t i = 0; i < len; ++i) a[i] += w * dx[k + i];
-          for (uint32_t i = 0; i < len; ++i) b[i] += w * dy[k + i];
-          for (uint32_t i = 0; i < len; ++i) c[i] += w * dz[k + i];
-          k += len;
-        }
+        m.blend(tg, t, float(s.value[f]) / float(tg.reference), &acc[0], &acc[V], &acc[2 * V]);
         updates += tg.delta_count;
       }
       seconds += std::chrono::duration<double>(Clock::now() - t0).count();
@@ -159,7 +163,7 @@ Timing time_float_kernel(const afm_doc &doc, const std::vector<afm_fap_state> &s
 Timing time_float(const afm_doc &doc, const std::vector<afm_fap_state> &states) {
   const afm_geometry &g = doc.geometry;
   const size_t V = g.vertex_count;
-  const std::vector<std::vector<float>> d = float_deltas(doc);
+  const FloatModel m(doc);
   std::vector<float> base(3 * V), ax(V), ay(V), az(V), out(3 * V);
   for (size_t v = 0; v < V; ++v) {
     base[3 * v] = g.origin[0] + g.px[v] * g.step;
@@ -168,10 +172,6 @@ Timing time_float(const afm_doc &doc, const std::vector<afm_fap_state> &states) 
   }
   out = base;
   std::vector<uint32_t> touched, stamp(V, 0);
-  std::vector<int> target_of(AFM_FAP_COUNT + 1, -1);
-  for (uint32_t t = 0; t < doc.target_count; ++t)
-    if (doc.targets[t].kind == AFM_TARGET_FAP && doc.targets[t].reference > 0)
-      target_of[doc.targets[t].number] = int(t);
   uint32_t frame = 0;
   double updates = 0;
   int n = 0;
@@ -183,26 +183,17 @@ Timing time_float(const afm_doc &doc, const std::vector<afm_fap_state> &states) 
       for (uint32_t v : touched) std::copy(&base[3 * v], &base[3 * v + 3], &out[3 * v]);
       touched.clear();
       for (int f = 3; f <= AFM_FAP_COUNT; ++f) {
-        int t = target_of[size_t(f)];
+        int t = m.target_of[size_t(f)];
         if (!s.value[f] || t < 0) continue;
         const afm_target &tg = doc.targets[t];
-        const float w = float(s.value[f]) / float(tg.reference);
-        const float *dx = d[size_t(t)].data(), *dy = dx + tg.delta_count, *dz = dy + tg.delta_count;
-        uint32_t k = 0;
-        for (uint32_t r = 0; r < tg.run_count; ++r) {
-          const uint32_t st = tg.runs[r].start, len = tg.runs[r].length;
-          for (uint32_t v = st; v < st + len; ++v)
+        for (uint32_t r = 0; r < tg.run_count; ++r)
+          for (uint32_t v = tg.runs[r].start; v < tg.runs[r].start + tg.runs[r].length; ++v)
             if (stamp[v] != frame) {
               stamp[v] = frame;
               touched.push_back(v);
               ax[v] = base[3 * v], ay[v] = base[3 * v + 1], az[v] = base[3 * v + 2];
             }
-          float *a = &ax[st], *b = &ay[st], *c = &az[st];
-          for (uint32_t i = 0; i < len; ++i) a[i] += w * dx[k + i];
-          for (uint32_t i = 0; i < len; ++i) b[i] += w * dy[k + i];
-          for (uint32_t i = 0; i < len; ++i) c[i] += w * dz[k + i];
-          k += len;
-        }
+        m.blend(tg, t, float(s.value[f]) / float(tg.reference), ax.data(), ay.data(), az.data());
         updates += tg.delta_count;
       }
       for (uint32_t v : touched) out[3 * v] = ax[v], out[3 * v + 1] = ay[v], out[3 * v + 2] = az[v];
