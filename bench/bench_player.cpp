@@ -47,14 +47,23 @@ struct Timing {
   double updates_per_frame;
 };
 
-Timing time_fixed(const afm_doc &doc, uint32_t flags, const std::vector<afm_fap_state> &states) {
-  afm_player_options o{};
-  o.flags = flags;
-  size_t need = 0;
-  afm_player_measure(&doc, &o, &need);
-  std::vector<uint64_t> mem(need / 8 + 1);
+// A player with `flags` in its own buffer.
+struct Player {
+  std::vector<uint64_t> memory;
   afm_player *p = nullptr;
-  if (afm_player_init(&doc, &o, mem.data(), need, &p) != AFM_OK) std::exit(1);
+  Player(const afm_doc &doc, uint32_t flags) {
+    afm_player_options o{};
+    o.flags = flags;
+    size_t need = 0;
+    afm_player_measure(&doc, &o, &need);
+    memory.resize(need / 8 + 1);
+    if (afm_player_init(&doc, &o, memory.data(), need, &p) != AFM_OK) std::exit(1);
+  }
+};
+
+Timing time_fixed(const afm_doc &doc, uint32_t flags, const std::vector<afm_fap_state> &states) {
+  Player player(doc, flags);
+  afm_player *p = player.p;
   double updates = 0;
   int n = 0;
   auto t0 = Clock::now();
@@ -108,13 +117,8 @@ struct FloatModel {
 // weights a pose of each state set up. Accumulators are reset between
 // repetitions outside the timed region.
 Timing time_fixed_kernel(const afm_doc &doc, const std::vector<afm_fap_state> &states) {
-  afm_player_options o{};
-  o.flags = AFM_PLAYER_NO_NORMALS;
-  size_t need = 0;
-  afm_player_measure(&doc, &o, &need);
-  std::vector<uint64_t> mem(need / 8 + 1);
-  afm_player *p = nullptr;
-  if (afm_player_init(&doc, &o, mem.data(), need, &p) != AFM_OK) std::exit(1);
+  Player player(doc, AFM_PLAYER_NO_NORMALS);
+  afm_player *p = player.p;
   double seconds = 0, updates = 0;
   int n = 0;
   while (seconds < 1.0) {

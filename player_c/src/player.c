@@ -52,7 +52,6 @@ static size_t layout(afm_player *p, uint8_t *base, const afm_doc *doc, uint32_t 
   }
 #undef TAKE
   if (p) {
-    p->total_runs = (uint32_t)R;
     p->restore_capacity = (uint32_t)(R + 4 * P + 1);
   }
   return at > (uint64_t)SIZE_MAX / 2 ? 0 : (size_t)at;

@@ -41,7 +41,6 @@ struct afm_player {
   uint8_t *moved;        /* [V] marks of this pose's morphed vertices; all 0 between poses */
   afm_span *dirty;       /* [all runs] disjoint spans the morph targets moved, ascending */
   uint32_t dirty_count;
-  uint32_t total_runs;
 
   /* Outputs, and what the last pose changed in them: the spans in
    * `restore` (morphed vertices and rigid parts) and the `stale` normals. */
