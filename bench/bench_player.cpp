@@ -61,22 +61,31 @@ struct Player {
   }
 };
 
-Timing time_fixed(const afm_doc &doc, uint32_t flags, const std::vector<afm_fap_state> &states) {
-  Player player(doc, flags);
-  afm_player *p = player.p;
+// Whole poses: `pose(state)` for every state, over and over for at least a
+// second; `pose` returns the vertex-target updates it made.
+template <class Pose>
+Timing time_poses(const std::vector<afm_fap_state> &states, Pose pose) {
   double updates = 0;
   int n = 0;
   auto t0 = Clock::now();
   double elapsed = 0;
   do {
     for (const afm_fap_state &s : states) {
-      afm_player_pose(p, &s, nullptr, 0);
-      updates += afm_player_info(p)->updates;
+      updates += pose(s);
       ++n;
     }
     elapsed = std::chrono::duration<double>(Clock::now() - t0).count();
   } while (elapsed < 1.0);
   return {elapsed / n, updates / n};
+}
+
+Timing time_fixed(const afm_doc &doc, uint32_t flags, const std::vector<afm_fap_state> &states) {
+  Player player(doc, flags);
+  afm_player *p = player.p;
+  return time_poses(states, [p](const afm_fap_state &s) {
+    afm_player_pose(p, &s, nullptr, 0);
+    return double(afm_player_info(p)->updates);
+  });
 }
 
 // The float side: every positive FAP target's deltas in model units (planar
@@ -177,37 +186,31 @@ Timing time_float(const afm_doc &doc, const std::vector<afm_fap_state> &states) 
   out = base;
   std::vector<uint32_t> touched, stamp(V, 0);
   uint32_t frame = 0;
-  double updates = 0;
-  int n = 0;
-  auto t0 = Clock::now();
-  double elapsed = 0;
-  do {
-    for (const afm_fap_state &s : states) {
-      ++frame;
-      for (uint32_t v : touched) std::copy(&base[3 * v], &base[3 * v + 3], &out[3 * v]);
-      touched.clear();
-      for (int f = 3; f <= AFM_FAP_COUNT; ++f) {
-        int t = m.target_of[size_t(f)];
-        if (!s.value[f] || t < 0) continue;
-        const afm_target &tg = doc.targets[t];
-        for (uint32_t r = 0; r < tg.run_count; ++r)
-          for (uint32_t v = tg.runs[r].start; v < tg.runs[r].start + tg.runs[r].length; ++v)
-            if (stamp[v] != frame) {
-              stamp[v] = frame;
-              touched.push_back(v);
-              ax[v] = base[3 * v], ay[v] = base[3 * v + 1], az[v] = base[3 * v + 2];
-            }
-        m.blend(tg, t, float(s.value[f]) / float(tg.reference), ax.data(), ay.data(), az.data());
-        updates += tg.delta_count;
-      }
-      for (uint32_t v : touched) out[3 * v] = ax[v], out[3 * v + 1] = ay[v], out[3 * v + 2] = az[v];
-      ++n;
+  Timing timing = time_poses(states, [&](const afm_fap_state &s) {
+    double updates = 0;
+    ++frame;
+    for (uint32_t v : touched) std::copy(&base[3 * v], &base[3 * v + 3], &out[3 * v]);
+    touched.clear();
+    for (int f = 3; f <= AFM_FAP_COUNT; ++f) {
+      int t = m.target_of[size_t(f)];
+      if (!s.value[f] || t < 0) continue;
+      const afm_target &tg = doc.targets[t];
+      for (uint32_t r = 0; r < tg.run_count; ++r)
+        for (uint32_t v = tg.runs[r].start; v < tg.runs[r].start + tg.runs[r].length; ++v)
+          if (stamp[v] != frame) {
+            stamp[v] = frame;
+            touched.push_back(v);
+            ax[v] = base[3 * v], ay[v] = base[3 * v + 1], az[v] = base[3 * v + 2];
+          }
+      m.blend(tg, t, float(s.value[f]) / float(tg.reference), ax.data(), ay.data(), az.data());
+      updates += tg.delta_count;
     }
-    elapsed = std::chrono::duration<double>(Clock::now() - t0).count();
-  } while (elapsed < 1.0);
+    for (uint32_t v : touched) out[3 * v] = ax[v], out[3 * v + 1] = ay[v], out[3 * v + 2] = az[v];
+    return updates;
+  });
   volatile float sink = out[0];
   (void)sink;
-  return {elapsed / n, updates / n};
+  return timing;
 }
 
 // The reference head with analytic targets, decoded (normal deltas stored

@@ -25,6 +25,7 @@
 
 #include "afm/format.h"
 #include "afm/player.h"
+#include "../tests/common/afm_doc_hash.h"
 
 #define FUZZ_MAX_DOC_BYTES ((size_t)256 << 20) /* larger documents are measured only */
 
@@ -33,121 +34,11 @@ static void fuzz_fail(const char *what, const char *detail) {
   abort();
 }
 
-/* A value-by-value hash of a document (as tests/arm/afm_hash.c), reading
- * every array through its full length. */
-#define FUZZ_STEP(h, v) ((h) = ((h) ^ (uint64_t)(v)) * 0x100000001b3u)
-
-static uint64_t fuzz_hash_i16(uint64_t h, const int16_t *a, size_t n) {
-  size_t i;
-  FUZZ_STEP(h, a != NULL);
-  if (a)
-    for (i = 0; i < n; ++i) FUZZ_STEP(h, (uint16_t)a[i]);
-  return h;
-}
-
-static uint64_t fuzz_hash_bytes(uint64_t h, const void *data, size_t n) {
-  const uint8_t *p = (const uint8_t *)data;
-  size_t i;
-  FUZZ_STEP(h, p != NULL);
-  if (p)
-    for (i = 0; i < n; ++i) FUZZ_STEP(h, p[i]);
-  return h;
-}
-
-static uint64_t fuzz_hash_string(uint64_t h, const char *s) {
-  return fuzz_hash_bytes(h, s, s ? strlen(s) + 1 : 0);
-}
-
-static uint64_t fuzz_hash_f32(uint64_t h, float f) {
-  uint32_t u;
-  memcpy(&u, &f, sizeof u);
-  FUZZ_STEP(h, u);
-  return h;
-}
-
-static uint64_t fuzz_hash_doc(const afm_doc *d) {
-  uint64_t h = 0xcbf29ce484222325u;
-  const afm_geometry *g = &d->geometry;
-  size_t V = g->vertex_count;
-  uint32_t i, k;
-  h = fuzz_hash_string(h, d->meta.name);
-  h = fuzz_hash_string(h, d->meta.units);
-  h = fuzz_hash_string(h, d->meta.generator);
-  h = fuzz_hash_f32(h, d->meta.es0);
-  h = fuzz_hash_f32(h, d->meta.irisd0);
-  h = fuzz_hash_f32(h, d->meta.ens0);
-  h = fuzz_hash_f32(h, d->meta.mns0);
-  h = fuzz_hash_f32(h, d->meta.mw0);
-  FUZZ_STEP(h, d->meta.fdp_count);
-  for (i = 0; i < d->meta.fdp_count; ++i) {
-    const afm_fdp_point *p = &d->meta.fdps[i];
-    FUZZ_STEP(h, p->group);
-    FUZZ_STEP(h, p->index);
-    FUZZ_STEP(h, p->vertex);
-    for (k = 0; k < 3; ++k) h = fuzz_hash_f32(h, p->pos[k]);
-  }
-  FUZZ_STEP(h, g->vertex_count);
-  FUZZ_STEP(h, g->triangle_count);
-  FUZZ_STEP(h, g->part_count);
-  FUZZ_STEP(h, g->attributes);
-  for (k = 0; k < 3; ++k) h = fuzz_hash_f32(h, g->origin[k]);
-  h = fuzz_hash_f32(h, g->step);
-  for (k = 0; k < 2; ++k) h = fuzz_hash_f32(h, g->uv_origin[k]);
-  for (k = 0; k < 2; ++k) h = fuzz_hash_f32(h, g->uv_step[k]);
-  for (i = 0; i < g->part_count; ++i) {
-    const afm_part *p = &g->parts[i];
-    h = fuzz_hash_string(h, p->name);
-    h = fuzz_hash_string(h, p->texture);
-    FUZZ_STEP(h, p->kind);
-    h = fuzz_hash_bytes(h, p->diffuse, 4);
-    FUZZ_STEP(h, p->first_vertex);
-    FUZZ_STEP(h, p->vertex_count);
-    FUZZ_STEP(h, p->first_triangle);
-    FUZZ_STEP(h, p->triangle_count);
-  }
-  h = fuzz_hash_i16(h, g->px, V);
-  h = fuzz_hash_i16(h, g->py, V);
-  h = fuzz_hash_i16(h, g->pz, V);
-  h = fuzz_hash_i16(h, g->nx, V);
-  h = fuzz_hash_i16(h, g->ny, V);
-  h = fuzz_hash_i16(h, g->nz, V);
-  h = fuzz_hash_i16(h, (const int16_t *)g->u, V);
-  h = fuzz_hash_i16(h, (const int16_t *)g->v, V);
-  h = fuzz_hash_bytes(h, g->rgba, g->rgba ? 4 * V : 0);
-  h = fuzz_hash_bytes(h, g->triangles, g->triangles ? 12 * (size_t)g->triangle_count : 0);
-  FUZZ_STEP(h, d->target_count);
-  for (i = 0; i < d->target_count; ++i) {
-    const afm_target *t = &d->targets[i];
-    FUZZ_STEP(h, t->kind);
-    FUZZ_STEP(h, t->number);
-    FUZZ_STEP(h, t->flags);
-    FUZZ_STEP(h, (uint32_t)t->reference);
-    FUZZ_STEP(h, t->run_count);
-    h = fuzz_hash_bytes(h, t->runs, t->runs ? t->run_count * sizeof *t->runs : 0);
-    FUZZ_STEP(h, t->delta_count);
-    h = fuzz_hash_i16(h, t->dx, t->delta_count);
-    h = fuzz_hash_i16(h, t->dy, t->delta_count);
-    h = fuzz_hash_i16(h, t->dz, t->delta_count);
-    h = fuzz_hash_i16(h, t->nx, t->delta_count);
-    h = fuzz_hash_i16(h, t->ny, t->delta_count);
-    h = fuzz_hash_i16(h, t->nz, t->delta_count);
-  }
-  FUZZ_STEP(h, d->rigid_count);
-  for (i = 0; i < d->rigid_count; ++i) {
-    const afm_rigid *r = &d->rigids[i];
-    FUZZ_STEP(h, r->kind);
-    for (k = 0; k < 3; ++k) FUZZ_STEP(h, (uint32_t)r->pivot[k]);
-    h = fuzz_hash_i16(h, r->axes, 9);
-    FUZZ_STEP(h, r->part_count);
-    h = fuzz_hash_i16(h, (const int16_t *)r->parts, r->part_count);
-    FUZZ_STEP(h, r->control_count);
-    for (k = 0; k < r->control_count; ++k) {
-      FUZZ_STEP(h, r->controls[k].fap);
-      FUZZ_STEP(h, r->controls[k].dof);
-      FUZZ_STEP(h, (uint32_t)r->controls[k].gain_q16);
-    }
-  }
-  return h;
+static uint64_t fuzz_hash_doc(const afm_doc *doc) {
+  hasher s;
+  hash_init(&s);
+  hash_doc(&s, doc);
+  return s.h;
 }
 
 /* A player on the document, posed neutral and then with FAP values, visemes

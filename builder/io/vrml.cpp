@@ -746,6 +746,31 @@ void put_number(std::string &out, double v) {
   out.append(buf, r.ptr);
 }
 
+// The numbers of a row or vector, separated by blanks.
+template <class Row>
+void put_numbers(std::string &out, const Row &row) {
+  for (Eigen::Index k = 0; k < row.size(); ++k) {
+    if (k) out += ' ';
+    put_number(out, row(k));
+  }
+}
+
+// An MFVec field's values: one row of `M` a line, each ended by ','.
+void put_rows(std::string &out, const Eigen::MatrixXd &M) {
+  for (Eigen::Index i = 0; i < M.rows(); ++i) {
+    out += "          ";
+    put_numbers(out, M.row(i));
+    out += ",\n";
+  }
+}
+
+// An index field: one triangle of `F` a line, ended by -1.
+void put_triangles(std::string &out, const Eigen::MatrixXi &F) {
+  for (Eigen::Index i = 0; i < F.rows(); ++i)
+    out += "          " + std::to_string(F(i, 0)) + ", " + std::to_string(F(i, 1)) + ", " +
+           std::to_string(F(i, 2)) + ", -1,\n";
+}
+
 bool is_id_char(char c, bool first) {
   const unsigned char u = static_cast<unsigned char>(c);
   if (u <= 0x20 || c == '"' || c == '#' || c == '\'' || c == ',' || c == '.' || c == '[' ||
@@ -840,53 +865,26 @@ Status write_vrml(const Scene &scene, const std::string &path) {
     const std::string faces = unique_id(faces_name);
     out += "DEF " + name + " Transform {\n  children [\n    Shape {\n      appearance Appearance {\n";
     out += "        material Material { diffuseColor ";
-    for (int k = 0; k < 3; ++k) {
-      if (k) out += ' ';
-      put_number(out, p.diffuse[k]);
-    }
+    put_numbers(out, p.diffuse);
     out += " }\n";
     if (!p.texture.empty()) out += "        texture ImageTexture { url " + quoted(p.texture) + " }\n";
     out += "      }\n      geometry DEF " + faces + " IndexedFaceSet {\n";
     out += "        ccw TRUE\n        solid FALSE\n";
     out += "        coord Coordinate { point [\n";
-    for (Eigen::Index i = 0; i < p.V.rows(); ++i) {
-      out += "          ";
-      for (int k = 0; k < 3; ++k) {
-        if (k) out += ' ';
-        put_number(out, p.V(i, k));
-      }
-      out += ",\n";
-    }
+    put_rows(out, p.V);
     out += "        ] }\n        coordIndex [\n";
-    for (Eigen::Index i = 0; i < p.F.rows(); ++i)
-      out += "          " + std::to_string(p.F(i, 0)) + ", " + std::to_string(p.F(i, 1)) + ", " +
-             std::to_string(p.F(i, 2)) + ", -1,\n";
+    put_triangles(out, p.F);
     out += "        ]\n";
     if (p.TC.rows() > 0 && p.FTC.rows() == p.F.rows()) {
       out += "        texCoord TextureCoordinate { point [\n";
-      for (Eigen::Index i = 0; i < p.TC.rows(); ++i) {
-        out += "          ";
-        put_number(out, p.TC(i, 0));
-        out += ' ';
-        put_number(out, p.TC(i, 1));
-        out += ",\n";
-      }
+      put_rows(out, p.TC);
       out += "        ] }\n        texCoordIndex [\n";
-      for (Eigen::Index i = 0; i < p.FTC.rows(); ++i)
-        out += "          " + std::to_string(p.FTC(i, 0)) + ", " + std::to_string(p.FTC(i, 1)) +
-               ", " + std::to_string(p.FTC(i, 2)) + ", -1,\n";
+      put_triangles(out, p.FTC);
       out += "        ]\n";
     }
     if (p.C.rows() == p.V.rows() && p.C.rows() > 0) {
       out += "        colorPerVertex TRUE\n        color Color { color [\n";
-      for (Eigen::Index i = 0; i < p.C.rows(); ++i) {
-        out += "          ";
-        for (int k = 0; k < 3; ++k) {
-          if (k) out += ' ';
-          put_number(out, p.C(i, k));
-        }
-        out += ",\n";
-      }
+      put_rows(out, p.C);
       out += "        ] }\n";
     }
     out += "      }\n    }\n  ]\n}\n\n";

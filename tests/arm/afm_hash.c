@@ -9,13 +9,15 @@
  * width (never over memory): the output does not depend on byte order, word
  * size, struct layout or pointers.
  *
- * Output:
- *   afm NAME V=... T=... targets=... rigids=... doc=HASH    the decoded document
- *   pose neutral HASH                                       (with the player)
- *   fap FILE: version ... frames=... stats ... HASH         one per stream
- *   frame I NUMBER fap=HASH [pose=HASH nd=HASH]             one per stream frame
- *   render K TIME_US pose=HASH                              the stream at 30 fps
- *   error ...                                               a refused file
+ * Output (pose=HASH nd=HASH: the default player's outputs and those of the
+ * one with AFM_PLAYER_NORMAL_DELTAS):
+ *   afm NAME V=... T=... parts=... targets=... rigids=... doc=HASH   the document
+ *   pose init HASH nd=HASH                   the players as init leaves them
+ *   pose neutral pose=HASH nd=HASH           the neutral state posed
+ *   fap FILE: version ... frames=... stats ... HASH          one per stream
+ *   frame I NUMBER fap=HASH state=HASH pose=HASH nd=HASH     one per stream frame
+ *   render K TIME_US t=T pose=HASH nd=HASH   the stream at 30 fps, states blended
+ *   error ...                                a refused file
  * Lines starting with '#' are facts that differ between builds (buffer sizes
  * that hold pointers); the comparison ignores them.
  *
@@ -31,212 +33,7 @@
 #include "afm/format.h"
 #include "afm/fap_stream.h"
 #include "afm/player.h"
-
-/* ---- hashing ---------------------------------------------------------------
- *
- * FNV-1a 64 over values rather than bytes: each step xors one value (a byte,
- * or a 16- or 32-bit integer zero-extended) into the state and multiplies by
- * the FNV prime. Values, not their bytes in memory, so the hash is the same
- * on every byte order and word size; a value is fed at its own width (an
- * int16 array hashes as 16-bit values, sign bits dropped by the cast). The
- * printed hash is the state after a final avalanche (hash_hex). */
-
-typedef struct hasher {
-  uint64_t h;
-} hasher;
-
-#define HASH_PRIME 0x100000001b3u
-#define HASH_STEP(h, v) ((h) = ((h) ^ (uint64_t)(v)) * HASH_PRIME)
-
-static void hash_init(hasher *s) { s->h = 0xcbf29ce484222325u; }
-
-/* Byte data (strings, u8 arrays), one step per byte. */
-static void hash_bytes(hasher *s, const void *data, size_t size) {
-  const uint8_t *p = (const uint8_t *)data;
-  uint64_t h = s->h;
-  size_t i;
-  for (i = 0; i < size; ++i) HASH_STEP(h, p[i]);
-  s->h = h;
-}
-
-static void hash_u8(hasher *s, uint8_t v) { HASH_STEP(s->h, v); }
-static void hash_u16(hasher *s, uint16_t v) { HASH_STEP(s->h, v); }
-static void hash_u32(hasher *s, uint32_t v) { HASH_STEP(s->h, v); }
-static void hash_i32(hasher *s, int32_t v) { HASH_STEP(s->h, (uint32_t)v); }
-
-/* A float by its bits (IEEE-754 binary32 on every target): no arithmetic. */
-static void hash_f32(hasher *s, float v) {
-  uint32_t u;
-  memcpy(&u, &v, sizeof u);
-  hash_u32(s, u);
-}
-
-/* Arrays: a presence value (NULL and empty differ), then the elements. */
-static void hash_i16s(hasher *s, const int16_t *a, size_t n) {
-  uint64_t h = s->h;
-  size_t i;
-  HASH_STEP(h, a != NULL);
-  if (a)
-    for (i = 0; i < n; ++i) HASH_STEP(h, (uint16_t)a[i]);
-  s->h = h;
-}
-
-static void hash_u16s(hasher *s, const uint16_t *a, size_t n) {
-  uint64_t h = s->h;
-  size_t i;
-  HASH_STEP(h, a != NULL);
-  if (a)
-    for (i = 0; i < n; ++i) HASH_STEP(h, a[i]);
-  s->h = h;
-}
-
-static void hash_i32s(hasher *s, const int32_t *a, size_t n) {
-  uint64_t h = s->h;
-  size_t i;
-  HASH_STEP(h, a != NULL);
-  if (a)
-    for (i = 0; i < n; ++i) HASH_STEP(h, (uint32_t)a[i]);
-  s->h = h;
-}
-
-static void hash_u32s(hasher *s, const uint32_t *a, size_t n) {
-  uint64_t h = s->h;
-  size_t i;
-  HASH_STEP(h, a != NULL);
-  if (a)
-    for (i = 0; i < n; ++i) HASH_STEP(h, a[i]);
-  s->h = h;
-}
-
-static void hash_u8s(hasher *s, const uint8_t *a, size_t n) {
-  hash_u8(s, a != NULL);
-  if (a) hash_bytes(s, a, n);
-}
-
-static void hash_string(hasher *s, const char *text) {
-  hash_u8(s, text != NULL);
-  if (text) hash_bytes(s, text, strlen(text) + 1);
-}
-
-/* The hash as 16 hex digits, after a final avalanche (MurmurHash3's fmix64)
- * so that every input bit reaches every output bit; `out` holds 17 bytes. */
-static const char *hash_hex(const hasher *s, char *out) {
-  static const char digits[] = "0123456789abcdef";
-  uint64_t h = s->h;
-  int i;
-  h ^= h >> 33;
-  h *= 0xff51afd7ed558ccdu;
-  h ^= h >> 33;
-  h *= 0xc4ceb9fe1a85ec53u;
-  h ^= h >> 33;
-  for (i = 0; i < 16; ++i) out[i] = digits[(h >> (60 - 4 * i)) & 0xF];
-  out[16] = '\0';
-  return out;
-}
-
-/* ---- the document --------------------------------------------------------- */
-
-static void hash_meta(hasher *s, const afm_meta *m) {
-  uint32_t i;
-  hash_string(s, m->name);
-  hash_string(s, m->units);
-  hash_string(s, m->generator);
-  hash_f32(s, m->es0);
-  hash_f32(s, m->irisd0);
-  hash_f32(s, m->ens0);
-  hash_f32(s, m->mns0);
-  hash_f32(s, m->mw0);
-  hash_u32(s, m->fdp_count);
-  for (i = 0; i < m->fdp_count; ++i) {
-    const afm_fdp_point *p = &m->fdps[i];
-    hash_u8(s, p->group);
-    hash_u8(s, p->index);
-    hash_u32(s, p->vertex);
-    hash_f32(s, p->pos[0]);
-    hash_f32(s, p->pos[1]);
-    hash_f32(s, p->pos[2]);
-  }
-}
-
-static void hash_geometry(hasher *s, const afm_geometry *g) {
-  uint32_t i;
-  size_t V = g->vertex_count;
-  hash_u32(s, g->vertex_count);
-  hash_u32(s, g->triangle_count);
-  hash_u32(s, g->part_count);
-  hash_u32(s, g->attributes);
-  for (i = 0; i < 3; ++i) hash_f32(s, g->origin[i]);
-  hash_f32(s, g->step);
-  for (i = 0; i < 2; ++i) hash_f32(s, g->uv_origin[i]);
-  for (i = 0; i < 2; ++i) hash_f32(s, g->uv_step[i]);
-  for (i = 0; i < g->part_count; ++i) {
-    const afm_part *p = &g->parts[i];
-    hash_string(s, p->name);
-    hash_string(s, p->texture);
-    hash_u8(s, p->kind);
-    hash_bytes(s, p->diffuse, 4);
-    hash_u32(s, p->first_vertex);
-    hash_u32(s, p->vertex_count);
-    hash_u32(s, p->first_triangle);
-    hash_u32(s, p->triangle_count);
-  }
-  hash_i16s(s, g->px, V);
-  hash_i16s(s, g->py, V);
-  hash_i16s(s, g->pz, V);
-  hash_i16s(s, g->nx, V);
-  hash_i16s(s, g->ny, V);
-  hash_i16s(s, g->nz, V);
-  hash_u16s(s, g->u, V);
-  hash_u16s(s, g->v, V);
-  hash_u8s(s, g->rgba, 4 * V);
-  hash_u32s(s, g->triangles, 3 * (size_t)g->triangle_count);
-}
-
-static void hash_target(hasher *s, const afm_target *t) {
-  uint32_t i;
-  hash_u8(s, t->kind);
-  hash_u8(s, t->number);
-  hash_u8(s, t->flags);
-  hash_i32(s, t->reference);
-  hash_u32(s, t->run_count);
-  for (i = 0; i < t->run_count; ++i) {
-    hash_u32(s, t->runs[i].start);
-    hash_u32(s, t->runs[i].length);
-  }
-  hash_u32(s, t->delta_count);
-  hash_i16s(s, t->dx, t->delta_count);
-  hash_i16s(s, t->dy, t->delta_count);
-  hash_i16s(s, t->dz, t->delta_count);
-  hash_i16s(s, t->nx, t->delta_count);
-  hash_i16s(s, t->ny, t->delta_count);
-  hash_i16s(s, t->nz, t->delta_count);
-}
-
-static void hash_rigid(hasher *s, const afm_rigid *r) {
-  uint32_t i;
-  hash_u8(s, r->kind);
-  hash_i32s(s, r->pivot, 3);
-  hash_i16s(s, r->axes, 9);
-  hash_u16(s, r->part_count);
-  hash_u16s(s, r->parts, r->part_count);
-  hash_u16(s, r->control_count);
-  for (i = 0; i < r->control_count; ++i) {
-    hash_u8(s, r->controls[i].fap);
-    hash_u8(s, r->controls[i].dof);
-    hash_i32(s, r->controls[i].gain_q16);
-  }
-}
-
-static void hash_doc(hasher *s, const afm_doc *doc) {
-  uint32_t i;
-  hash_meta(s, &doc->meta);
-  hash_geometry(s, &doc->geometry);
-  hash_u32(s, doc->target_count);
-  for (i = 0; i < doc->target_count; ++i) hash_target(s, &doc->targets[i]);
-  hash_u32(s, doc->rigid_count);
-  for (i = 0; i < doc->rigid_count; ++i) hash_rigid(s, &doc->rigids[i]);
-  hash_u32(s, doc->skipped_chunks);
-}
+#include "../common/afm_doc_hash.h"
 
 /* ---- files ------------------------------------------------------------------ */
 
@@ -275,19 +72,20 @@ static const char *base_name(const char *path) {
 
 /* ---- the player's outputs ------------------------------------------------ */
 
-/* Everything a pose produces. The lead's per-frame outputs go here: add any
- * new output array below, serialised with the typed helpers. */
-static void hash_pose(hasher *s, const afm_player *player, const afm_doc *doc) {
+/* Everything a pose produces, as printed hex. */
+static const char *pose_hex(const afm_player *player, const afm_doc *doc, char *hex) {
   size_t V = doc->geometry.vertex_count;
   const afm_pose_info *info = afm_player_info(player);
-  const afm_q12 *weights = afm_player_weights(player);
-  hash_i32s(s, afm_player_positions(player), 3 * V);
-  hash_i16s(s, afm_player_normals(player), 3 * V);
-  hash_i16s(s, weights, doc->target_count);
-  hash_u32(s, info->active_targets);
-  hash_u32(s, info->updates);
-  hash_u32(s, info->clamped_weights);
-  hash_u32(s, info->weight_shift);
+  hasher s;
+  hash_init(&s);
+  hash_i32s(&s, afm_player_positions(player), 3 * V);
+  hash_i16s(&s, afm_player_normals(player), 3 * V);
+  hash_i16s(&s, afm_player_weights(player), doc->target_count);
+  hash_u32(&s, info->active_targets);
+  hash_u32(&s, info->updates);
+  hash_u32(&s, info->clamped_weights);
+  hash_u32(&s, info->weight_shift);
+  return hash_hex(&s, hex);
 }
 
 /* Two players: the default (normals recomputed) and AFM_PLAYER_NORMAL_DELTAS. */
@@ -331,20 +129,13 @@ static void players_free(players *p) {
 /* Poses both players; appends " pose=H nd=H" to the current line. */
 static int pose_line(players *p, const afm_doc *doc, const afm_fap_state *a,
                      const afm_fap_state *b, afm_q16 t) {
-  hasher s;
   char hex[17];
   afm_result r = afm_player_pose(p->plain, a, b, t);
   if (r == AFM_OK) {
-    hash_init(&s);
-    hash_pose(&s, p->plain, doc);
-    printf(" pose=%s", hash_hex(&s, hex));
+    printf(" pose=%s", pose_hex(p->plain, doc, hex));
     r = afm_player_pose(p->deltas, a, b, t);
   }
-  if (r == AFM_OK) {
-    hash_init(&s);
-    hash_pose(&s, p->deltas, doc);
-    printf(" nd=%s", hash_hex(&s, hex));
-  }
+  if (r == AFM_OK) printf(" nd=%s", pose_hex(p->deltas, doc, hex));
   if (r != AFM_OK) printf(" pose-error=%s", afm_result_string(r));
   return r == AFM_OK;
 }
@@ -371,6 +162,18 @@ static void hash_frame(hasher *s, const afm_fap_frame *f) {
     hash_u8(s, f->expression.init_face);
     hash_u8(s, f->expression.def);
   }
+}
+
+/* What the player keeps of the stream after a frame. */
+static void hash_state(hasher *s, const afm_fap_state *state) {
+  hash_i32s(s, state->value, AFM_FAP_COUNT + 1);
+  hash_u8(s, state->viseme.select1);
+  hash_u8(s, state->viseme.select2);
+  hash_u8(s, state->viseme.blend);
+  hash_u8(s, state->expression.select1);
+  hash_u8(s, state->expression.intensity1);
+  hash_u8(s, state->expression.select2);
+  hash_u8(s, state->expression.intensity2);
 }
 
 static uint64_t frame_hash(const afm_fap_frame *f) {
@@ -445,7 +248,7 @@ static int check_incremental(const uint8_t *data, size_t size, const afm_fap_fra
   return ok;
 }
 
-static int play_stream(const char *path, const afm_doc *doc, void *player_state) {
+static int play_stream(const char *path, const afm_doc *doc, players *p) {
   size_t size = 0;
   uint8_t *data = read_file(path, &size);
   afm_fap_frame *frames = NULL;
@@ -457,8 +260,6 @@ static int play_stream(const char *path, const afm_doc *doc, void *player_state)
   hasher all;
   char hex[17];
   int ok = 1;
-  (void)doc;
-  (void)player_state;
   if (!data) {
     fprintf(stderr, "afm_hash: cannot read %s\n", path);
     return 2;
@@ -505,7 +306,6 @@ static int play_stream(const char *path, const afm_doc *doc, void *player_state)
          (unsigned long)stats.skipped_values, hash_hex(&all, hex));
 
   {
-    players *p = (players *)player_state;
     afm_fap_state state;
     afm_fap_cursor cursor;
     afm_fap_state_reset(&state);
@@ -518,14 +318,7 @@ static int play_stream(const char *path, const afm_doc *doc, void *player_state)
       /* ---- per-frame player output: the state after this frame, posed ---- */
       afm_fap_state_apply(&state, &frames[i], 0);
       hash_init(&s);
-      hash_i32s(&s, state.value, AFM_FAP_COUNT + 1);
-      hash_u8(&s, state.viseme.select1);
-      hash_u8(&s, state.viseme.select2);
-      hash_u8(&s, state.viseme.blend);
-      hash_u8(&s, state.expression.select1);
-      hash_u8(&s, state.expression.intensity1);
-      hash_u8(&s, state.expression.select2);
-      hash_u8(&s, state.expression.intensity2);
+      hash_state(&s, &state);
       printf(" state=%s", hash_hex(&s, hex));
       if (!pose_line(p, doc, &state, NULL, 0)) ok = 0;
       printf("\n");
@@ -572,7 +365,6 @@ int main(int argc, char **argv) {
   char hex[17];
   int i, status = 0;
   players p;
-  void *player_state = &p;
 
   if (argc < 2 || argv[1][0] == '-') {
     fprintf(stderr, "usage: afm_hash FACE.afm [STREAM.fap ...]\n");
@@ -610,6 +402,7 @@ int main(int argc, char **argv) {
          (unsigned long)bytes);
   hash_init(&s);
   hash_doc(&s, doc);
+  hash_u32(&s, doc->skipped_chunks);
   printf("afm %s V=%lu T=%lu parts=%lu targets=%lu rigids=%lu doc=%s\n", base_name(argv[1]),
          (unsigned long)doc->geometry.vertex_count, (unsigned long)doc->geometry.triangle_count,
          (unsigned long)doc->geometry.part_count, (unsigned long)doc->target_count,
@@ -622,14 +415,9 @@ int main(int argc, char **argv) {
   }
   {
     afm_fap_state neutral;
-    hasher ps;
-    /* As init leaves it, then the neutral state posed. */
-    hash_init(&ps);
-    hash_pose(&ps, p.plain, doc);
-    printf("pose init %s", hash_hex(&ps, hex));
-    hash_init(&ps);
-    hash_pose(&ps, p.deltas, doc);
-    printf(" nd=%s\n", hash_hex(&ps, hex));
+    /* As init leaves them, then the neutral state posed. */
+    printf("pose init %s", pose_hex(p.plain, doc, hex));
+    printf(" nd=%s\n", pose_hex(p.deltas, doc, hex));
     afm_fap_state_reset(&neutral);
     printf("pose neutral");
     if (!pose_line(&p, doc, &neutral, NULL, 0)) status = 1;
@@ -637,7 +425,7 @@ int main(int argc, char **argv) {
   }
 
   for (i = 2; i < argc; ++i) {
-    int st = play_stream(argv[i], doc, player_state);
+    int st = play_stream(argv[i], doc, &p);
     if (st > status) status = st;
   }
   players_free(&p);
