@@ -68,6 +68,8 @@ Grid position_grid(const Scene &scene) {
 
 }  // namespace
 
+double afm_position_quantum(const Scene &scene) { return static_cast<double>(position_grid(scene).step); }
+
 std::vector<std::vector<int>> run_friendly_order(const Scene &scene,
                                                  const std::vector<MorphTarget> &targets,
                                                  double quantum) {

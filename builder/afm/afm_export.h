@@ -79,6 +79,12 @@ std::vector<std::vector<int>> run_friendly_order(const Scene &scene,
                                                  const std::vector<MorphTarget> &targets,
                                                  double quantum);
 
+// The model units per quantum of the AFM position grid encode_afm() uses for
+// this scene (positions and morph target deltas alike): the largest half
+// extent of the scene's bounding box / 32766.5. The builder's solver
+// tolerance derives from it.
+double afm_position_quantum(const Scene &scene);
+
 // Encodes the content; `profile` AFM_PROFILE_DRACO uses the Draco codec.
 Expected<std::vector<uint8_t>> encode_afm(const AfmContent &content, afm_profile profile);
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "afm/render.h"
 
@@ -90,6 +91,43 @@ Expected<std::vector<std::vector<uint8_t>>> render_scene(const Scene &scene, con
       meshes.push_back(m);
     }
   }
+  // Overlay markers; their positions live in marker_pos while meshes points at them.
+  std::vector<std::vector<float>> marker_pos(options.markers.size());
+  float auto_bias = -1.0f;
+  for (size_t i = 0; i < options.markers.size(); ++i) {
+    const SceneMarkers &mk = options.markers[i];
+    if (mk.points.rows() == 0) continue;
+    if (mk.points.cols() != 3)
+      return Status::error("render: marker set " + std::to_string(i) + " has " +
+                           std::to_string(mk.points.cols()) + " columns, not 3");
+    std::vector<float> &pos = marker_pos[i];
+    pos.resize((size_t)mk.points.rows() * 3);
+    for (int r = 0; r < mk.points.rows(); ++r)
+      for (int k = 0; k < 3; ++k) pos[(size_t)r * 3 + k] = (float)mk.points(r, k);
+    float bias = mk.depth_bias;
+    if (bias == 0.0f) {
+      if (auto_bias < 0.0f) {
+        Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300);
+        Eigen::Vector3d hi = Eigen::Vector3d::Constant(-1e300);
+        for (const Part &p : scene.parts)
+          if (p.V.rows() > 0 && p.V.cols() == 3) {
+            lo = lo.cwiseMin(p.V.colwise().minCoeff().transpose());
+            hi = hi.cwiseMax(p.V.colwise().maxCoeff().transpose());
+          }
+        auto_bias = lo.x() <= hi.x() ? (float)(0.01 * (hi - lo).norm()) : 0.0f;
+      }
+      bias = auto_bias;
+    }
+    afm_render_mesh m{};
+    m.positions = pos.data();
+    m.vertex_count = (size_t)mk.points.rows();
+    for (int c = 0; c < 3; ++c) m.color[c] = std::clamp(mk.color[c], 0.0f, 1.0f);
+    m.color[3] = 1.0f;
+    m.unlit = 1;
+    m.point_size = mk.size_pixels;
+    m.depth_bias = bias;
+    meshes.push_back(m);
+  }
   if (meshes.empty()) return Status::error("render: the scene has no triangles");
 
   afm_render_view view;
@@ -103,6 +141,12 @@ Expected<std::vector<std::vector<uint8_t>>> render_scene(const Scene &scene, con
         hi[k] = std::max(hi[k], (float)p.pos[k]);
       }
     }
+    if (lo[0] <= hi[0])  // markers stay in the picture
+      for (const std::vector<float> &pos : marker_pos)
+        for (size_t i = 0; i < pos.size(); ++i) {
+          lo[i % 3] = std::min(lo[i % 3], pos[i]);
+          hi[i % 3] = std::max(hi[i % 3], pos[i]);
+        }
     if (lo[0] <= hi[0]) {
       const float pad = 0.15f * (hi[1] - lo[1]);
       for (int k = 0; k < 3; ++k) {

@@ -6,6 +6,7 @@
 // writes one PNG.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -21,14 +22,27 @@ struct SceneView {
   float pitch_deg = 0;  // positive: the camera moves up and looks down
 };
 
+// Extra points drawn over the scene as unlit square dots (overlays: key
+// points, lines drawn as dense dots).
+struct SceneMarkers {
+  Eigen::MatrixXd points;                    // #P x 3, model units
+  Eigen::Vector3f color{1.0f, 1.0f, 1.0f};   // RGB in [0,1]
+  float size_pixels = 3.0f;
+  // Pulls the dots toward the viewer by this many model units so those lying
+  // on a surface are not hidden by it; 0: 1 % of the diagonal of the box of
+  // the scene's parts.
+  float depth_bias = 0.0f;
+};
+
 struct SceneRenderOptions {
   int width = 600, height = 720;  // of each view
   std::vector<SceneView> views{SceneView{}, SceneView{40.0f, 5.0f}};
   bool wireframe = false;       // triangle edges over the skin
   float fdp_dot_pixels = 7.0f;  // size of FDP dots when FDPs are given; 0 draws none
   // Frame only the face (the FDPs' box without the ears, skull top and
-  // spine) instead of every part. Needs FDPs.
+  // spine, grown to hold the markers) instead of every part. Needs FDPs.
   bool face_closeup = false;
+  std::vector<SceneMarkers> markers;  // drawn after the FDPs, in order
 };
 
 // Renders each view into an RGBA8 image (top row first), in order.

@@ -9,14 +9,9 @@
 
 #include "afm/afm_export.h"
 #include "afm/analytic_targets.h"
-#include "core/fapu.h"
-#include "core/orient.h"
-#include "core/part_kind.h"
-#include "core/repair.h"
-#include "core/validate.h"
-#include "io/fdp_io.h"
 #include "core/atomic_file.h"
-#include "io/mesh_io.h"
+#include "core/fapu.h"
+#include "io/load_face.h"
 
 using namespace afmb;
 
@@ -128,33 +123,16 @@ int main(int argc, char **argv) {
     return 2;
   }
 
-  Expected<Scene> scene = read_scene(mesh_path);
-  if (!scene) return fail(scene.status());
-  if (flip_v)
-    for (Part &p : scene->parts)
-      if (p.TC.rows()) p.TC.col(1) = (1.0 - p.TC.col(1).array()).matrix();
-  Expected<FdpSet> fdps = read_fdp(fdp_path, fdp_format);
-  if (!fdps) return fail(fdps.status());
-  if (Status s = bind_fdps(*fdps, *scene); !s) return fail(s);
-
-  if (!orient_spec.empty()) {
-    Expected<Orientation> o =
-        orient_spec == "auto" ? detect_orientation(*fdps) : parse_orientation(orient_spec);
-    if (!o) return fail(o.status().wrap("--orient"));
-    apply_orientation(*o, *scene, *fdps);
-    std::printf("orientation: applied %s\n", o->spec().c_str());
-  }
-  if (Status s = check_orientation(*fdps); !s) return fail(s.wrap(mesh_path));
-
-  guess_part_kinds(*scene);
-  assign_part_kinds(*scene, *fdps);
-  const int skin = scene->find_kind(PartKind::Skin);
-  if (skin < 0)
-    return fail(Status::error(mesh_path + ": no skin part: no part holds FDP 2.1 (chin)"));
-  std::vector<std::string> repairs;
-  repair_coincident_vertices(*scene, skin, &repairs);
-  for (const std::string &r : repairs) std::printf("repaired: %s\n", r.c_str());
-  if (Status s = check_skin(*scene, skin); !s) return fail(s);
+  LoadOptions lo;
+  lo.orient = orient_spec;
+  lo.fdp_format = fdp_format;
+  lo.flip_v = flip_v;
+  std::vector<std::string> log;
+  Expected<LoadedFace> face = load_face(mesh_path, fdp_path, lo, &log);
+  for (const std::string &line : log) std::printf("%s\n", line.c_str());
+  if (!face) return fail(face.status());
+  Scene *scene = &face->scene;
+  FdpSet *fdps = &face->fdps;
 
   std::printf("mesh: %s: %zu parts, %zu vertices, %zu triangles%s%s\n", mesh_path.c_str(),
               scene->parts.size(), scene->vertex_count(), scene->triangle_count(),

@@ -1,0 +1,106 @@
+// The anatomical face model: skin tissue, muscles and jaw put together from a
+// scene and its FDPs, calibrated, and posed (method paper sections 2 and 3).
+//
+//   FaceModel model = *build_face_model(scene, fdps, options);
+//   Activation a;  a.muscles = {{model.find("zygomaticus_major_left"), 60.0}};
+//   Pose pose = *solve_pose(model, a, &cache);
+//   Eigen::MatrixXd skin = pose_epidermis(model, pose);   // #V x 3
+//
+// Contraction is in percent of each muscle's calibrated range (section 3.3):
+// +100 % moves its key node by MuscleDef::max_fraction of the fibre length
+// (or semi-axis) in the direction of its action, -100 % by min_fraction the
+// other way; in between, the tension is interpolated linearly (the motion is
+// then close to linear, not exactly: the springs are biphasic).
+//
+// Dynamic node sets (section 3.2.4): every solve runs on a set of skin
+// vertices; the rest stay exactly where they are. A muscle's set V_d is grown
+// from its influence area at +100 % by rings of the mesh until no vertex on
+// the set's border moves more than the wave threshold (by default the
+// solver tolerance, half an AFM quantum): the elastic wave has died out.
+// A pose solves on the union of its muscles' (and the jaw's) sets and grows
+// it again if the combination reaches further.
+#pragma once
+
+#include <Eigen/Core>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "anatomy/jaw.h"
+#include "anatomy/muscles.h"
+#include "anatomy/skin_model.h"
+#include "anatomy/solver.h"
+#include "core/fapu.h"
+#include "core/fdp.h"
+#include "core/scene.h"
+
+namespace afmb {
+
+struct FaceModelOptions {
+  TissueParams tissue;
+  SolverOptions solver;          // tolerance 0: half the AFM position quantum of the scene
+  double wave_threshold = 0;     // model units; 0: the solver tolerance
+  bool estimate_missing_fdps = true;  // fdp_completion.h; off: skip (or fail on) their muscles
+  bool calibrate = true;         // off: no calibration, no V_d (pictures of the placement only)
+  // Calibrate only these muscles (names; empty: all) and the jaw only when
+  // `calibrate_jaw`. Posing an uncalibrated muscle is an error. For tests and
+  // tools that need a few muscles of a big model.
+  std::vector<std::string> calibrate_only;
+  bool calibrate_jaw = true;
+  // Called after each step of the build: done of total, and what was done.
+  std::function<void(int done, int total, const std::string &what)> progress;
+};
+
+struct FaceModel {
+  int skin = -1;                 // scene part index
+  FdpSet fdps;                   // the input's FDPs plus estimates
+  Fapu fapu;
+  SkinModel tissue;
+  std::vector<Muscle> muscles;   // placed muscles, in table order
+  Jaw jaw;
+  double quantum = 0;            // AFM position step (afm_position_quantum)
+  SolverOptions solver;          // tolerance filled in
+  double wave_threshold = 0;
+  std::vector<std::string> notes;     // FDP estimates
+  std::vector<std::string> warnings;  // skipped muscles, naming their FDPs
+
+  int find(const std::string &muscle) const;  // index into muscles, or -1
+};
+
+// Fails on: no skin part (FDP 2.1), a skin that check_skin() refuses
+// (non-manifold, degenerate), FDPs not in the MPEG-4 frame
+// (check_orientation), a skin facing inward or not wrapping its centre (not
+// a face), a missing FDP of an essential muscle or of the jaw, and a
+// calibration that does not converge.
+Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &fdps,
+                                     const FaceModelOptions &options);
+
+struct Activation {
+  std::vector<std::pair<int, double>> muscles;  // (index into FaceModel::muscles, percent -100..100)
+  double jaw_open = 0, jaw_thrust = 0, jaw_shift = 0;  // percent (open >= 0)
+};
+
+struct PoseOptions {
+  bool whole_mesh = false;  // solve on every skin vertex instead of the dynamic set
+  const SolverOptions *solver = nullptr;  // override the model's
+};
+
+struct Pose {
+  Eigen::MatrixXd X;          // 4n x 3 node positions
+  std::vector<int> dynamic;   // the vertices solved, sorted
+  SolveStats stats;           // of the last solve (summed iterations over the growth rounds)
+  int rounds = 0;             // solves (1 + growth rounds)
+};
+
+// Fails when the solver fails (the message says why); never returns an
+// unconverged pose.
+Expected<Pose> solve_pose(const FaceModel &model, const Activation &activation, FactorCache *cache,
+                          const PoseOptions &options = {});
+
+// The epidermis of a pose, #V x 3 (the skin part's vertex positions).
+Eigen::MatrixXd pose_epidermis(const FaceModel &model, const Pose &pose);
+
+// The signed tension of muscle i at `percent` contraction.
+double muscle_tension(const Muscle &m, double percent);
+
+}  // namespace afmb

@@ -1,0 +1,114 @@
+#include "anatomy/jaw.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "anatomy/muscles.h"
+
+namespace afmb {
+
+namespace {
+
+// Moeller-Trumbore: the parameter t of the segment o + t d (0 <= t <= 1) where
+// it meets triangle abc, or a negative number.
+double segment_triangle(const Eigen::Vector3d &o, const Eigen::Vector3d &d, const Eigen::Vector3d &a,
+                        const Eigen::Vector3d &b, const Eigen::Vector3d &c) {
+  const Eigen::Vector3d e1 = b - a, e2 = c - a, p = d.cross(e2);
+  const double det = e1.dot(p);
+  if (std::abs(det) < 1e-30) return -1;
+  const Eigen::Vector3d s = o - a;
+  const double u = s.dot(p) / det;
+  if (u < 0 || u > 1) return -1;
+  const Eigen::Vector3d q = s.cross(e1);
+  const double v = d.dot(q) / det;
+  if (v < 0 || u + v > 1) return -1;
+  const double t = e2.dot(q) / det;
+  return t >= 0 && t <= 1 ? t : -1;
+}
+
+}  // namespace
+
+Expected<Jaw> build_jaw(const SkinModel &skin, const FdpSet &fdps, const Fapu &fapu) {
+  const char *need[] = {"2.1", "2.2", "2.3", "2.4", "2.5", "2.8", "2.9", "2.11", "2.12", "2.13", "2.14", "5.3", "5.4"};
+  std::string absent;
+  for (const char *id : need)
+    if (!fdps.find(*FdpId::parse(id))) absent += std::string(absent.empty() ? "" : ", ") + id;
+  if (!absent.empty()) return Status::error("jaw needs FDPs " + absent);
+  auto P = [&](const char *id) -> Eigen::Vector3d { return fdps.find(*FdpId::parse(id))->pos; };
+
+  Jaw jaw;
+  Eigen::Vector3d top_l = P("2.13"), top_r = P("2.14");
+  top_l.y() = P("2.4").y();
+  top_r.y() = P("2.5").y();
+  const Eigen::Vector3d top[7] = {top_l, P("2.4"), P("2.8"), P("2.3"), P("2.9"), P("2.5"), top_r};
+  const Eigen::Vector3d bottom[7] = {P("2.13"), P("2.11"), (P("2.11") + P("2.1")) / 2, P("2.1"),
+                                     (P("2.1") + P("2.12")) / 2, P("2.12"), P("2.14")};
+  jaw.V.resize(14, 3);
+  const double s = skin.params.skull_scale;
+  for (int j = 0; j < 7; ++j) {
+    jaw.V.row(j) = (skin.centre + s * (top[j] - skin.centre)).transpose();
+    jaw.V.row(7 + j) = (skin.centre + s * (bottom[j] - skin.centre)).transpose();
+  }
+  jaw.F.resize(12, 3);
+  for (int j = 0; j < 6; ++j) {
+    jaw.F.row(2 * j) << j, 7 + j, 7 + j + 1;
+    jaw.F.row(2 * j + 1) << j, 7 + j + 1, j + 1;
+  }
+
+  for (int v = 0; v < skin.n; ++v) {
+    if (!skin.in_mesh[static_cast<size_t>(v)]) continue;
+    const Eigen::Vector3d o = skin.X0.row(v);
+    const Eigen::Vector3d d = -2.5 * skin.thickness[v] * skin.normal.row(v).transpose();
+    for (int f = 0; f < jaw.F.rows(); ++f)
+      if (segment_triangle(o, d, jaw.V.row(jaw.F(f, 0)), jaw.V.row(jaw.F(f, 1)), jaw.V.row(jaw.F(f, 2))) >= 0) {
+        jaw.ray_hits.push_back(v);
+        break;
+      }
+  }
+
+  // The breadth-first fix of section 3.2.3.
+  Expected<MouthWindow> w = mouth_window(fdps);
+  if (!w) return w.status().wrap("jaw");
+  auto skin_vertex = [&](const char *id) {
+    const FdpPoint *p = fdps.find(*FdpId::parse(id), skin.part);
+    if (p && p->part == skin.part && p->vertex >= 0) return p->vertex;
+    int best = -1;
+    double bd = 0;
+    for (int v = 0; v < skin.n; ++v) {
+      const double dd = (skin.X0.row(v).transpose() - p->pos).squaredNorm();
+      if (skin.in_mesh[static_cast<size_t>(v)] && (best < 0 || dd < bd)) best = v, bd = dd;
+    }
+    return best;
+  };
+  const std::vector<int> upper = mouth_window_search(skin, *w, skin_vertex("2.2"));
+  const std::vector<int> lower = mouth_window_search(skin, *w, skin_vertex("2.3"));
+  std::vector<int> set;
+  for (int v : jaw.ray_hits)
+    if (!std::binary_search(upper.begin(), upper.end(), v)) set.push_back(v);
+  jaw.removed = static_cast<int>(jaw.ray_hits.size() - set.size());
+  std::vector<int> merged;
+  std::set_union(set.begin(), set.end(), lower.begin(), lower.end(), std::back_inserter(merged));
+  jaw.added = static_cast<int>(merged.size() - set.size());
+  jaw.vertices = std::move(merged);
+  if (jaw.vertices.empty()) return Status::error("jaw: no skin vertex maps to the jaw");
+
+  jaw.pivot = Eigen::Vector3d(0, (P("5.3").y() + P("5.4").y()) / 2, (P("2.13").z() + P("2.14").z()) / 2);
+  jaw.axis = Eigen::Vector3d::UnitX();
+  jaw.max_open = 20.0 * 3.14159265358979323846 / 180.0;
+  jaw.max_thrust = fapu.mw0 / 5;
+  jaw.max_shift = fapu.mw0 / 5;
+  return jaw;
+}
+
+Eigen::Affine3d jaw_motion(const Jaw &jaw, double open_pct, double thrust_pct, double shift_pct) {
+  const double angle = std::max(0.0, open_pct) / 100.0 * jaw.max_open;
+  Eigen::Affine3d t = Eigen::Affine3d::Identity();
+  t.translate(thrust_pct / 100.0 * jaw.max_thrust * Eigen::Vector3d::UnitZ() +
+              shift_pct / 100.0 * jaw.max_shift * Eigen::Vector3d::UnitX());
+  t.translate(jaw.pivot);
+  t.rotate(Eigen::AngleAxisd(angle, jaw.axis));
+  t.translate(-jaw.pivot);
+  return t;
+}
+
+}  // namespace afmb

@@ -1,0 +1,57 @@
+// The lower jaw (method paper section 3.2.3): a jaw mesh estimated from the
+// FDPs, the skin vertices it carries, and its motion.
+//
+// Jaw mesh (our reading of the paper's Figure 6, which is not reproduced): a
+// band of 7 x 2 points, from the face's left to its right,
+//   upper row  (2.13 at the height of 2.4), 2.4, 2.8, 2.3, 2.9, 2.5, (2.14 at the height of 2.5)
+//   lower row  2.13, 2.11, (2.11 + 2.1) / 2, 2.1, (2.1 + 2.12) / 2, 2.12, 2.14
+// i.e. the lower lip's inner contour above, the jaw line below, split into 12
+// triangles, then pushed onto the skull surface (scaled around the skin's
+// centre of gravity like the skull layer).
+//
+// Mapping (after Kaehler et al.): a segment is traced from every skin vertex
+// inward along its normal, 2.5 tissue thicknesses long; the vertices whose
+// segment meets the jaw mesh are the jaw's. Then the breadth-first fix: the
+// mouth-window search from 2.2 removes upper-lip vertices, the one from 2.3
+// adds the lower lip and chin.
+//
+// Motion: rotation about the condyles' axis, +x through the pivot
+//   pivot = (0, mean of 5.3.y and 5.4.y, mean of 2.13.z and 2.14.z),
+// the cheekbones' height and the jaw corners' depth; positive angles open
+// the mouth (the chin goes down and back). 100 % opening is 20 degrees, 100 %
+// thrust is MW0 / 5 forward (+z), 100 % shift is MW0 / 5 toward the face's
+// left (+x).
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <string>
+#include <vector>
+
+#include "anatomy/skin_model.h"
+#include "core/fapu.h"
+#include "core/fdp.h"
+
+namespace afmb {
+
+struct Jaw {
+  Eigen::MatrixXd V;                // 14 x 3 jaw mesh, on the skull surface
+  Eigen::MatrixXi F;                // 12 x 3
+  std::vector<int> ray_hits;        // skin vertices whose inward segment meets the mesh, sorted
+  std::vector<int> vertices;        // after the breadth-first fix, sorted
+  int added = 0, removed = 0;       // by the fix
+  Eigen::Vector3d pivot = Eigen::Vector3d::Zero();
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitX();
+  double max_open = 0;              // radians at 100 %
+  double max_thrust = 0, max_shift = 0;  // model units at 100 %
+  std::vector<int> dynamic;         // V_d of a full opening, sorted
+};
+
+// FDPs the jaw needs: 2.1-2.5, 2.8, 2.9, 2.11-2.14, 5.3, 5.4. Fails naming
+// the missing ones.
+Expected<Jaw> build_jaw(const SkinModel &skin, const FdpSet &fdps, const Fapu &fapu);
+
+// The rigid motion for opening, thrust and shift in percent (open >= 0).
+Eigen::Affine3d jaw_motion(const Jaw &jaw, double open_pct, double thrust_pct, double shift_pct);
+
+}  // namespace afmb

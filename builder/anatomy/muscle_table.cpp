@@ -1,0 +1,162 @@
+#include "anatomy/muscle_table.h"
+
+#include <cctype>
+#include <cmath>
+#include <map>
+
+namespace afmb {
+
+namespace {
+
+using K = MuscleKind;
+
+// name, kind, attachment | semi-major end, insertion | semi-minor end, epicentre,
+// width, sense, max, min, calibrate_minor, lips_or_cheeks, essential.
+// Decisions where the paper's tables slip (docs/anatomy.md):
+//  - frontalis_inner_right: the paper writes 11.3 (the left hairline) in its
+//    attachment; every other right frontalis uses 11.2, so 11.2 here.
+//  - risorius_right: the paper starts it at 5.4, which makes it the same
+//    fibre as zygomaticus_major_right (5.4 -> 8.4); the left one starts at
+//    5.1 (the cheek's centre), so the right one starts at 5.2.
+//  - orbicularis_oris: the paper's epicentre (n + m) / 2 with n = 8.2,
+//    m = 8.3 lies between the lower lip and the left corner; the mouth's
+//    centre, halfway between 8.1 and 8.2, here.
+const std::vector<MuscleDef> kTable = {
+    {"frontalis_inner_left", K::Linear, "11.1 + 1/6 (11.3 - 11.1)", "4.1", nullptr, 0.30, +1, 0.18, 0.06, false, false, false},
+    {"frontalis_inner_right", K::Linear, "11.1 + 1/6 (11.2 - 11.1)", "4.2", nullptr, 0.30, +1, 0.18, 0.06, false, false, false},
+    {"frontalis_major_left", K::Linear, "11.1 + 1/3 (11.3 - 11.1)", "4.3", nullptr, 0.30, +1, 0.18, 0.06, false, false, false},
+    {"frontalis_major_right", K::Linear, "11.1 + 1/3 (11.2 - 11.1)", "4.4", nullptr, 0.30, +1, 0.18, 0.06, false, false, false},
+    {"frontalis_outer_left", K::Linear, "11.1 + 2/3 (11.3 - 11.1)", "4.5", nullptr, 0.30, +1, 0.18, 0.06, false, false, false},
+    {"frontalis_outer_right", K::Linear, "11.1 + 2/3 (11.2 - 11.1)", "4.6", nullptr, 0.30, +1, 0.18, 0.06, false, false, false},
+    {"corrugator_left", K::Linear, "4.3", "4.3 + (4.3 - 4.1)", nullptr, 0.40, +1, 0.25, 0.08, false, false, false},
+    {"corrugator_right", K::Linear, "4.4", "4.4 + (4.4 - 4.2)", nullptr, 0.40, +1, 0.25, 0.08, false, false, false},
+    {"nasalis_left", K::Linear, "9.7", "9.1", nullptr, 0.30, +1, 0.15, 0.05, false, false, false},
+    {"nasalis_right", K::Linear, "9.6", "9.2", nullptr, 0.30, +1, 0.15, 0.05, false, false, false},
+    {"upper_lip_left", K::Linear, "9.5 + 1/2 (9.15 - 9.5)", "8.10", nullptr, 0.40, -1, 0.40, 0.15, false, true, false},
+    {"upper_lip_right", K::Linear, "9.4 + 1/2 (9.15 - 9.4)", "8.9", nullptr, 0.40, -1, 0.40, 0.15, false, true, false},
+    {"zygomaticus_minor_left", K::Linear, "3.9", "8.5 + 1/2 (2.6 - 8.5)", nullptr, 0.20, +1, 0.20, 0.06, false, true, false},
+    {"zygomaticus_minor_right", K::Linear, "3.10", "8.6 + 1/2 (2.7 - 8.6)", nullptr, 0.20, +1, 0.20, 0.06, false, true, false},
+    {"zygomaticus_major_left", K::Linear, "5.3", "8.3", nullptr, 0.25, +1, 0.25, 0.08, false, true, true},
+    {"zygomaticus_major_right", K::Linear, "5.4", "8.4", nullptr, 0.25, +1, 0.25, 0.08, false, true, true},
+    {"risorius_left", K::Linear, "5.1", "8.3", nullptr, 0.25, +1, 0.20, 0.06, false, true, true},
+    {"risorius_right", K::Linear, "5.2", "8.4", nullptr, 0.25, +1, 0.20, 0.06, false, true, true},
+    {"depressor_anguli_left", K::Linear, "8.3 + (8.3 - 9.1)", "8.3", nullptr, 0.35, +1, 0.30, 0.10, false, false, true},
+    {"depressor_anguli_right", K::Linear, "8.4 + (8.4 - 9.2)", "8.4", nullptr, 0.35, +1, 0.30, 0.10, false, false, true},
+    {"mentalis_left", K::Linear, "2.1 + (2.1 - (8.4 + (8.4 - 9.2)))", "2.8", nullptr, 0.35, -1, 0.20, 0.08, false, false, true},
+    {"mentalis_right", K::Linear, "2.1 + (2.1 - (8.3 + (8.3 - 9.1)))", "2.9", nullptr, 0.35, -1, 0.20, 0.08, false, false, true},
+    {"orbicularis_oculi_left", K::Sphincter, "3.7", "3.9", "3.5", 1.8, +1, 0.50, 0.20, true, false, false},
+    {"orbicularis_oculi_right", K::Sphincter, "3.12", "3.10", "3.6", 1.8, +1, 0.50, 0.20, true, false, false},
+    {"orbicularis_oris", K::Sphincter, "8.3", "8.2", "1/2 (8.1 + 8.2)", 1.6, +1, 0.25, 0.10, false, true, true},
+};
+
+struct Parser {
+  const std::string &s;
+  size_t at = 0;
+  std::string error;
+
+  void skip() {
+    while (at < s.size() && std::isspace(static_cast<unsigned char>(s[at]))) ++at;
+  }
+  bool fail(const std::string &what) {
+    if (error.empty())
+      error = "key point '" + s + "': " + what + " at column " + std::to_string(at + 1);
+    return false;
+  }
+  // Digits and dots: "11.3", "1", "6".
+  std::string number() {
+    size_t start = at;
+    while (at < s.size() && (std::isdigit(static_cast<unsigned char>(s[at])) || s[at] == '.')) ++at;
+    return s.substr(start, at - start);
+  }
+  bool term(double scale, std::map<FdpId, double> &out) {
+    skip();
+    if (at < s.size() && std::isdigit(static_cast<unsigned char>(s[at]))) {
+      const size_t start = at;
+      std::string a = number();
+      skip();
+      if (at < s.size() && s[at] == '/') {  // a fraction, then a term
+        ++at;
+        skip();
+        std::string b = number();
+        if (a.find('.') != std::string::npos || b.empty() || b.find('.') != std::string::npos ||
+            std::stoi(b) == 0)
+          return fail("bad fraction");
+        return term(scale * std::stoi(a) / std::stoi(b), out);
+      }
+      std::optional<FdpId> id = FdpId::parse(a);
+      if (!id) {
+        at = start;
+        return fail("'" + a + "' is not an FDP");
+      }
+      out[*id] += scale;
+      return true;
+    }
+    if (at < s.size() && s[at] == '(') {
+      ++at;
+      if (!expr(scale, out)) return false;
+      skip();
+      if (at >= s.size() || s[at] != ')') return fail("expected ')'");
+      ++at;
+      return true;
+    }
+    return fail("expected an FDP, a fraction or '('");
+  }
+  bool expr(double scale, std::map<FdpId, double> &out) {
+    if (!term(scale, out)) return false;
+    for (;;) {
+      skip();
+      if (at >= s.size() || (s[at] != '+' && s[at] != '-')) return true;
+      const double sign = s[at] == '+' ? 1.0 : -1.0;
+      ++at;
+      if (!term(scale * sign, out)) return false;
+    }
+  }
+};
+
+}  // namespace
+
+const std::vector<MuscleDef> &muscle_table() { return kTable; }
+
+int find_muscle(const std::string &name) {
+  for (size_t i = 0; i < kTable.size(); ++i)
+    if (name == kTable[i].name) return static_cast<int>(i);
+  return -1;
+}
+
+Expected<Keypoint> parse_keypoint(const std::string &text) {
+  Parser p{text, 0, {}};
+  std::map<FdpId, double> terms;
+  if (!p.expr(1.0, terms)) return Status::error(p.error);
+  p.skip();
+  if (p.at != text.size()) {
+    p.fail("unexpected text");
+    return Status::error(p.error);
+  }
+  Keypoint k;
+  k.text = text;
+  double sum = 0;
+  for (const auto &[id, c] : terms) {
+    if (std::abs(c) < 1e-12) continue;  // 11.1 - 11.1 and the like
+    k.terms.emplace_back(id, c);
+    sum += c;
+  }
+  if (std::abs(sum - 1.0) > 1e-9)
+    return Status::error("key point '" + text + "': coefficients sum to " + std::to_string(sum) +
+                         ", not 1: not a point");
+  return k;
+}
+
+std::vector<FdpId> missing_fdps(const Keypoint &k, const FdpSet &fdps) {
+  std::vector<FdpId> out;
+  for (const auto &[id, c] : k.terms)
+    if (!fdps.find(id)) out.push_back(id);
+  return out;
+}
+
+Eigen::Vector3d eval_keypoint(const Keypoint &k, const FdpSet &fdps) {
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  for (const auto &[id, c] : k.terms) p += c * fdps.find(id)->pos;
+  return p;
+}
+
+}  // namespace afmb

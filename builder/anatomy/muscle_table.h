@@ -1,0 +1,80 @@
+// The 25 muscles of the method paper (Tables 1 and 2), as data.
+//
+// Key points are written as in the paper, affine combinations of FDP
+// positions: "11.1 + 1/6 (11.3 - 11.1)". parse_keypoint() turns one into
+// (FDP, coefficient) pairs and eval_keypoint() evaluates it on a bound FDP
+// set. docs/anatomy.md lists the table with the decisions taken where the
+// paper's Table 1 and 2 slip.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "core/fdp.h"
+#include "core/status.h"
+
+namespace afmb {
+
+enum class MuscleKind { Linear, Sphincter };
+
+// One row of Table 1 or 2 plus the constants the paper leaves to the
+// implementer. Sides are the face's own (MPEG-4: left is +x).
+struct MuscleDef {
+  const char *name;  // "zygomaticus_major_left": lower case, '_' separated, unique
+  MuscleKind kind;
+  // Linear: attachment (skull) and insertion (dermis) key points.
+  // Sphincter: a = end of the semi-major axis, b = end of the semi-minor
+  // axis (both on the hypodermis) and the epicentre (a free point).
+  const char *attachment_or_major;
+  const char *insertion_or_minor;
+  const char *epicentre;  // sphincters only, else nullptr
+  // Linear: the muscular width coefficient omega (section 3.2.1): a node is
+  // in the influence area when its distance to the central fibre is below
+  // omega x fibre length. Sphincter: the influence ellipse is the key-point
+  // ellipse scaled by this factor (the paper's equation 1 with the axes
+  // multiplied by it; 1 would cover the lid margins and lips only).
+  double width;
+  // +1: contracting pulls the insertion toward the attachment (every real
+  // linear muscle). -1: the paper drives this muscle the other way (Table 3
+  // raises the lower lip with "mentalis 150" and lowers the upper lip with
+  // "upper lip 150" although both attachments lie on the far side), so its
+  // anatomical action, a positive contraction here, pushes.
+  int sense;
+  // The displacement at +100 % and at -100 % contraction (section 3.3),
+  // as fractions of the fibre length (linear: the insertion moves along the
+  // fibre) or of the semi-axis (sphincter: the semi-axis key node moves
+  // toward the epicentre; which axis is `calibrate_minor`).
+  double max_fraction, min_fraction;
+  bool calibrate_minor;  // sphincters: calibrate on the minor axis node
+  // Lips and cheeks (section 3.2.4): the nodes of the influence area are not
+  // tied to the skull (hypodermis-to-skull springs of zero stiffness, no
+  // skull rejection).
+  bool lips_or_cheeks;
+  // Without it the face cannot make its basic FAPs: a build without its FDPs
+  // fails instead of skipping the muscle.
+  bool essential;
+};
+
+// The 25 muscles, in the paper's order (Table 1 top to bottom, left before
+// right, then Table 2).
+const std::vector<MuscleDef> &muscle_table();
+// Index in muscle_table() of a muscle name, or -1.
+int find_muscle(const std::string &name);
+
+// A key point: sum of coefficient x FDP position, coefficients summing to 1.
+struct Keypoint {
+  std::vector<std::pair<FdpId, double>> terms;
+  std::string text;  // as written in the table
+};
+
+// Grammar: expr := term { ('+' | '-') term }; term := [a/b] ( FDP | '(' expr ')' ).
+// Errors quote the text and the offending position.
+Expected<Keypoint> parse_keypoint(const std::string &text);
+
+// The FDPs a key point needs that `fdps` lacks (empty: it can be evaluated).
+std::vector<FdpId> missing_fdps(const Keypoint &k, const FdpSet &fdps);
+// Evaluates on the first point of each FDP. Precondition: nothing missing.
+Eigen::Vector3d eval_keypoint(const Keypoint &k, const FdpSet &fdps);
+
+}  // namespace afmb

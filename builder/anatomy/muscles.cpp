@@ -1,0 +1,217 @@
+#include "anatomy/muscles.h"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+
+namespace afmb {
+
+namespace {
+
+constexpr double kHalfPi = 1.5707963267948966;
+
+int nearest_node(const SkinModel &skin, int layer, const Eigen::Vector3d &p) {
+  int best = -1;
+  double bd = 0;
+  for (int v = 0; v < skin.n; ++v) {
+    if (!skin.in_mesh[static_cast<size_t>(v)]) continue;
+    const double d = (skin.X0.row(skin.node(layer, v)).transpose() - p).squaredNorm();
+    if (best < 0 || d < bd) best = v, bd = d;
+  }
+  return best < 0 ? -1 : skin.node(layer, best);
+}
+
+double segment_distance(const Eigen::Vector3d &p, const Eigen::Vector3d &a, const Eigen::Vector3d &b) {
+  const Eigen::Vector3d ab = b - a;
+  const double t = std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
+  return (p - (a + t * ab)).norm();
+}
+
+Status missing(const MuscleDef &d, const std::vector<FdpId> &ids) {
+  std::string list;
+  for (const FdpId &id : ids) list += (list.empty() ? "" : ", ") + id.str();
+  return Status::error(std::string("muscle ") + d.name + " needs FDP" + (ids.size() > 1 ? "s " : " ") + list);
+}
+
+}  // namespace
+
+Expected<Muscle> place_muscle(const SkinModel &skin, const FdpSet &fdps, int def) {
+  const MuscleDef &d = muscle_table()[static_cast<size_t>(def)];
+  Muscle m;
+  m.def = def;
+  m.name = d.name;
+  m.kind = d.kind;
+  m.sense = d.sense;
+  m.width = d.width;
+  std::vector<Keypoint> keys;
+  std::vector<FdpId> absent;
+  for (const char *text : {d.attachment_or_major, d.insertion_or_minor, d.epicentre}) {
+    if (!text) continue;
+    Expected<Keypoint> k = parse_keypoint(text);
+    if (!k) return k.status();
+    for (const FdpId &id : missing_fdps(*k, fdps))
+      if (std::find(absent.begin(), absent.end(), id) == absent.end()) absent.push_back(id);
+    keys.push_back(*k);
+  }
+  if (!absent.empty()) return missing(d, absent);
+  m.key_a = eval_keypoint(keys[0], fdps);
+  m.key_b = eval_keypoint(keys[1], fdps);
+
+  if (d.kind == MuscleKind::Linear) {
+    m.force_layer = kDermis;
+    m.node_a = nearest_node(skin, kSkull, m.key_a);
+    m.node_b = nearest_node(skin, kDermis, m.key_b);
+    const Eigen::Vector3d a = skin.X0.row(m.node_a), b = skin.X0.row(m.node_b);
+    m.length = (b - a).norm();
+    if (!(m.length > 0))
+      return Status::error(std::string("muscle ") + d.name + ": attachment and insertion map to one point");
+    const double reach = m.width * m.length;
+    for (int v = 0; v < skin.n; ++v) {
+      if (!skin.in_mesh[static_cast<size_t>(v)]) continue;
+      const Eigen::Vector3d p = skin.X0.row(skin.node(kDermis, v));
+      if (segment_distance(p, a, b) >= reach) continue;
+      const double D = (p - a).norm();
+      const double cosa = D > 0 ? (p - a).dot(b - a) / (D * m.length) : 0.0;
+      double radial = 0;
+      if (D <= m.length) radial = std::sin(kHalfPi * D / m.length);
+      else if (D <= m.length + reach) radial = std::cos(kHalfPi * (D - m.length) / reach);
+      const double w = skin.area[v] * std::max(0.0, cosa) * radial;
+      if (w <= 0) continue;
+      m.influence.push_back(v);
+      m.weight.push_back(w);
+    }
+  } else {
+    m.force_layer = kHypodermis;
+    m.epicentre = eval_keypoint(keys[2], fdps);
+    m.node_a = nearest_node(skin, kHypodermis, m.key_a);
+    m.node_b = nearest_node(skin, kHypodermis, m.key_b);
+    m.semi_a = std::abs(skin.X0(m.node_a, 0) - m.epicentre.x());
+    m.semi_b = std::abs(skin.X0(m.node_b, 1) - m.epicentre.y());
+    if (!(m.semi_a > 0) || !(m.semi_b > 0))
+      return Status::error(std::string("muscle ") + d.name + ": a semi-axis has zero length");
+    const int near = nearest_node(skin, kEpidermis, m.epicentre);
+    m.epicentre_normal = skin.normal.row(skin.vertex_of(near));
+    for (int v = 0; v < skin.n; ++v) {
+      if (!skin.in_mesh[static_cast<size_t>(v)]) continue;
+      const Eigen::Vector3d p = skin.X0.row(skin.node(kHypodermis, v));
+      const double ex = (p.x() - m.epicentre.x()) / m.semi_a, ey = (p.y() - m.epicentre.y()) / m.semi_b;
+      const double rho = std::sqrt(ex * ex + ey * ey);
+      if (rho > m.width) continue;                                           // equation 1
+      if (skin.normal.row(v).dot(m.epicentre_normal) < 0) continue;           // equation 2
+      const double g = rho <= 1 ? 1.0 : std::cos(kHalfPi * (rho - 1) / (m.width - 1));
+      const double w = skin.area[v] * g;
+      if (w <= 0) continue;
+      m.influence.push_back(v);
+      m.weight.push_back(w);
+    }
+  }
+  if (m.influence.empty())
+    return Status::error(std::string("muscle ") + d.name + ": no skin node in its influence area");
+  return m;
+}
+
+Expected<MouthWindow> mouth_window(const FdpSet &fdps) {
+  auto need = [&](const char *id) -> const FdpPoint * { return fdps.find(*FdpId::parse(id)); };
+  const FdpPoint *p22 = need("2.2"), *p24 = need("2.4"), *p25 = need("2.5");
+  if (!p22 || !p24 || !p25) return Status::error("mouth window needs FDPs 2.2, 2.4 and 2.5");
+  MouthWindow w;
+  if (const FdpPoint *p = need("9.15")) {
+    w.top = p->pos.y();
+  } else if (const FdpPoint *t = need("9.3"), *u = need("8.1"); t && u) {
+    w.top = t->pos.y() + (u->pos.y() - t->pos.y()) / 4;  // the FAPU's nose-base rule
+  } else {
+    return Status::error("mouth window needs FDP 9.15, or 9.3 and 8.1");
+  }
+  if (const FdpPoint *p = need("2.11")) w.bottom = p->pos.y() - std::abs((p->pos.y() - p22->pos.y()) / 2);
+  else if (const FdpPoint *c = need("2.1")) w.bottom = c->pos.y();
+  else return Status::error("mouth window needs FDP 2.11 or 2.1");
+  w.left = std::min(p24->pos.x(), p25->pos.x());
+  w.right = std::max(p24->pos.x(), p25->pos.x());
+  return w;
+}
+
+std::vector<int> mouth_window_search(const SkinModel &skin, const MouthWindow &w, int start) {
+  auto inside = [&](int v) {
+    const Eigen::Vector3d p = skin.X0.row(v);
+    return p.x() > w.left && p.x() < w.right && p.y() > w.bottom && p.y() < w.top;
+  };
+  std::vector<int> out;
+  if (start < 0 || start >= skin.n || !inside(start)) return out;
+  std::vector<uint8_t> seen(static_cast<size_t>(skin.n), 0);
+  std::deque<int> queue{start};
+  seen[static_cast<size_t>(start)] = 1;
+  while (!queue.empty()) {
+    const int v = queue.front();
+    queue.pop_front();
+    out.push_back(v);
+    for (int u : skin.neighbours[static_cast<size_t>(v)])
+      if (!seen[static_cast<size_t>(u)] && inside(u)) {
+        seen[static_cast<size_t>(u)] = 1;
+        queue.push_back(u);
+      }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+void remove_from_influence(Muscle &m, const std::vector<int> &vertices) {
+  std::vector<int> inf;
+  std::vector<double> w;
+  for (size_t i = 0; i < m.influence.size(); ++i)
+    if (!std::binary_search(vertices.begin(), vertices.end(), m.influence[i])) {
+      inf.push_back(m.influence[i]);
+      w.push_back(m.weight[i]);
+    }
+  m.influence = std::move(inf);
+  m.weight = std::move(w);
+}
+
+double muscle_load(const SkinModel &skin, const Muscle &m, double tension, const Eigen::MatrixXd &X,
+                   Eigen::MatrixXd *F) {
+  if (tension == 0) return 0.0;
+  const double s = m.sense * tension;
+  double energy = 0;
+  if (m.kind == MuscleKind::Linear) {
+    // Directions at rest: a pull toward a moving point is stable, a push
+    // away from one (mentalis, negative contractions) is not, transversally.
+    const Eigen::Vector3d a = skin.X0.row(m.node_a);
+    for (size_t i = 0; i < m.influence.size(); ++i) {
+      const int node = skin.node(m.force_layer, m.influence[i]);
+      const Eigen::Vector3d x0 = skin.X0.row(node);
+      const Eigen::Vector3d u = (a - x0).normalized();
+      energy -= s * m.weight[i] * (X.row(node).transpose() - x0).dot(u);
+      if (F) F->row(node) += (s * m.weight[i]) * u.transpose();
+    }
+  } else {
+    const double floor = m.semi_b / 3;
+    for (size_t i = 0; i < m.influence.size(); ++i) {
+      const int node = skin.node(m.force_layer, m.influence[i]);
+      const Eigen::Vector3d d(X(node, 0) - m.epicentre.x(), X(node, 1) - m.epicentre.y(), 0.0);
+      const double r = d.norm();
+      energy += s * m.weight[i] * (r >= floor ? r : r * r / (2 * floor) + floor / 2);
+      if (F) F->row(node) -= (s * m.weight[i] / std::max(r, floor)) * d.transpose();
+    }
+  }
+  return energy;
+}
+
+double muscle_action(const SkinModel &skin, const Muscle &m, const Eigen::MatrixXd &X) {
+  if (m.kind == MuscleKind::Linear) {
+    const Eigen::Vector3d a0 = skin.X0.row(m.node_a), b0 = skin.X0.row(m.node_b), b = X.row(m.node_b);
+    return m.sense * (b - b0).dot((a0 - b0).normalized());
+  }
+  const bool minor = muscle_table()[static_cast<size_t>(m.def)].calibrate_minor;
+  const int node = minor ? m.node_b : m.node_a;
+  auto dist = [&](const Eigen::MatrixXd &P) {
+    return std::hypot(P(node, 0) - m.epicentre.x(), P(node, 1) - m.epicentre.y());
+  };
+  return dist(skin.X0) - dist(X);
+}
+
+double muscle_action_target(const Muscle &m, bool maximum) {
+  const MuscleDef &d = muscle_table()[static_cast<size_t>(m.def)];
+  const double scale = m.kind == MuscleKind::Linear ? m.length : (d.calibrate_minor ? m.semi_b : m.semi_a);
+  return maximum ? d.max_fraction * scale : -d.min_fraction * scale;
+}
+
+}  // namespace afmb

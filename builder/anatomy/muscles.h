@@ -1,0 +1,106 @@
+// Waters muscles placed on the skin model (method paper sections 3.1, 3.2.1,
+// 3.2.2): key points from the FDPs, mapped to nodes; influence areas; the
+// force fields.
+//
+// Linear muscle (attachment A on the skull, insertion I on the dermis, fibre
+// length L = |I - A| at rest). A dermis node p is in the influence area when
+// its distance to the segment AI is below omega L (the width coefficient).
+// It is pulled toward A (along the rest direction) with the weight
+//   w = area(p) cos(alpha) R(D),   alpha = angle(I - A, p - A) (0 beyond 90 deg),
+//   D = |p - A|,  R = sin(pi/2 D / L)                       for D <= L,
+//                 R = cos(pi/2 (D - L) / (omega L))          for L < D <= (1 + omega) L,
+// Waters' angular and radial fall-offs with the fall-off starting at the
+// insertion (Rs = L) and ending omega L beyond it (Rf).
+//
+// Sphincter (epicentre e, semi-axes a along x and b along y, from the key
+// points' distances to e along those axes, as in the paper's equation 1).
+// A hypodermis node p is in the influence area when
+//   ((p.x - e.x) / (k a))^2 + ((p.y - e.y) / (k b))^2 <= 1   (k: the width)
+//   and n(p) . n(e) >= 0                                       (equation 2),
+// n(e) being the normal of the epidermal vertex nearest e. With
+// rho = sqrt(((p.x - e.x) / a)^2 + ((p.y - e.y) / b)^2) the weight is
+//   w = area(p) g(rho),  g = 1 for rho <= 1, cos(pi/2 (rho - 1) / (k - 1)) beyond,
+// and the pull points at e in the x-y plane: -(d.x, d.y, 0) / max(|d.xy|, b / 3).
+//
+// Force on a node: sense x t x w x direction, where t is the signed tension
+// (model force per unit area; positive: the muscle's action, negative: the
+// other way) and sense is the table's +1 / -1.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "anatomy/muscle_table.h"
+#include "anatomy/skin_model.h"
+#include "core/fdp.h"
+#include "core/fapu.h"
+
+namespace afmb {
+
+struct Muscle {
+  int def = -1;            // index into muscle_table()
+  std::string name;
+  MuscleKind kind = MuscleKind::Linear;
+  int sense = 1;
+  // Key points as computed from the FDPs (model units), before mapping.
+  Eigen::Vector3d key_a = Eigen::Vector3d::Zero();  // attachment, or semi-major end
+  Eigen::Vector3d key_b = Eigen::Vector3d::Zero();  // insertion, or semi-minor end
+  // Mapped nodes (global node indices into SkinModel::X0).
+  int node_a = -1;         // linear: skull node; sphincter: hypodermis node
+  int node_b = -1;         // linear: dermis node; sphincter: hypodermis node
+  double length = 0;       // linear: rest fibre length |node_b - node_a|
+  // Sphincter.
+  Eigen::Vector3d epicentre = Eigen::Vector3d::Zero();
+  Eigen::Vector3d epicentre_normal = Eigen::Vector3d::UnitZ();
+  double semi_a = 0, semi_b = 0;  // model units, along x and y
+  double width = 0;        // omega, or the sphincter's ellipse scale k
+  int force_layer = kDermis;  // kDermis (linear) or kHypodermis (sphincter)
+  std::vector<int> influence;   // skin vertices, sorted
+  std::vector<double> weight;   // per influence vertex
+  // Calibration (section 3.3): tension at +100 % and at -100 % contraction.
+  double tension_max = 0, tension_min = 0;
+  std::vector<int> dynamic;     // V_d: vertices the elastic wave moves, sorted
+};
+
+// Places one muscle of the table: evaluates its key points, maps them to the
+// nearest node of the proper layer and computes its influence area. Fails
+// naming the FDPs when some are missing from `fdps`.
+Expected<Muscle> place_muscle(const SkinModel &skin, const FdpSet &fdps, int def);
+
+// The mouth window of section 3.2.1, in model units along x and y.
+struct MouthWindow {
+  double top = 0, bottom = 0, left = 0, right = 0;  // left < right (x), bottom < top (y)
+};
+// top = 9.15.y (else the FAPU's nose-base height), bottom = 2.11.y -
+// |2.11.y - 2.2.y| / 2 (else 2.1.y), and the sides at the inner lip corners
+// 2.4 and 2.5: the paper's margin of MW0/20 beyond them lets the search
+// round the corners into the other lip on meshes whose lips meet there.
+Expected<MouthWindow> mouth_window(const FdpSet &fdps);
+
+// Breadth-first search over the skin mesh from vertex `start`, through
+// vertices strictly inside the window. Returns the vertices reached, sorted.
+std::vector<int> mouth_window_search(const SkinModel &skin, const MouthWindow &w, int start);
+
+// Removes `vertices` (sorted) from a muscle's influence area.
+void remove_from_influence(Muscle &m, const std::vector<int> &vertices);
+
+// The muscle's load at signed tension t and positions X: returns its
+// potential energy and, when F is given, adds its forces (4n x 3). The field
+// is conservative: a linear muscle's pull is a dead load along the rest
+// direction u0 from the node to A, potential -t sense w (p - p0) . u0 (a
+// push away from a moving point would be unstable across the fibre); a
+// sphincter's t sense w h(|d.xy|), h(r) = r beyond the
+// floor b / 3 and r^2 / (2 floor) + floor / 2 within it.
+double muscle_load(const SkinModel &skin, const Muscle &m, double tension, const Eigen::MatrixXd &X,
+                   Eigen::MatrixXd *F);
+
+// How far the muscle has acted at positions X (model units, positive in the
+// direction of its action): linear, the insertion's motion along the fibre
+// toward the attachment times sense; sphincter, the calibrated semi-axis
+// node's motion toward the epicentre in the x-y plane.
+double muscle_action(const SkinModel &skin, const Muscle &m, const Eigen::MatrixXd &X);
+// The action at +100 % (positive) and at -100 % (negative) contraction.
+double muscle_action_target(const Muscle &m, bool maximum);
+
+}  // namespace afmb

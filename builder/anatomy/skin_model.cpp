@@ -1,0 +1,216 @@
+#include "anatomy/skin_model.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+
+namespace afmb {
+
+namespace {
+
+// The three tetrahedra of a slab prism, as corners: 0-2 the upper triangle,
+// 3-5 the lower one. A fixed split; every element uses the same.
+constexpr int kTets[3][4] = {{0, 1, 2, 3}, {1, 2, 3, 4}, {2, 3, 4, 5}};
+
+double tet_volume(const Eigen::Vector3d &p0, const Eigen::Vector3d &p1, const Eigen::Vector3d &p2,
+                  const Eigen::Vector3d &p3) {
+  return (p1 - p0).dot((p2 - p0).cross(p3 - p0)) / 6.0;
+}
+
+}  // namespace
+
+double SkinModel::stiffness(const Spring &s) const {
+  if (s.slab == 2 && s.kind != SpringKind::Layer) {
+    // A bone tie: one end on the hypodermis, the other on the skull.
+    const int hypo = layer_of(s.a) == kHypodermis ? s.a : s.b;
+    if (skull_free[static_cast<size_t>(vertex_of(hypo))]) return 0.0;
+  }
+  return s.k;
+}
+
+Expected<SkinModel> build_skin_model(const Scene &scene, int part, const TissueParams &params) {
+  if (part < 0 || part >= static_cast<int>(scene.parts.size()))
+    return Status::error("skin model: no skin part");
+  const Part &p = scene.parts[static_cast<size_t>(part)];
+  if (p.F.rows() == 0) return Status::error("skin model: part '" + p.name + "' has no triangles");
+  if (!(params.skull_scale > 0 && params.skull_scale < 1) || !(params.dermis_depth > 0) ||
+      !(params.dermis_depth < params.hypodermis_depth) || !(params.hypodermis_depth < 1))
+    return Status::error("skin model: need 0 < skull_scale < 1 and 0 < dermis_depth < "
+                         "hypodermis_depth < 1");
+
+  SkinModel m;
+  m.part = part;
+  m.params = params;
+  m.n = static_cast<int>(p.V.rows());
+  m.F = p.F;
+  const int n = m.n;
+
+  // Centre of gravity of the surface, areas and normals.
+  m.area = Eigen::VectorXd::Zero(n);
+  m.normal = Eigen::MatrixXd::Zero(n, 3);
+  m.in_mesh.assign(static_cast<size_t>(n), 0);
+  m.vertex_faces.assign(static_cast<size_t>(n), {});
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  double total = 0;
+  for (int f = 0; f < m.F.rows(); ++f) {
+    const Eigen::Vector3d a = p.V.row(m.F(f, 0)), b = p.V.row(m.F(f, 1)), d = p.V.row(m.F(f, 2));
+    const Eigen::Vector3d nrm = (b - a).cross(d - a);  // twice the area
+    const double ar = 0.5 * nrm.norm();
+    c += ar * (a + b + d) / 3.0;
+    total += ar;
+    for (int k = 0; k < 3; ++k) {
+      const int v = m.F(f, k);
+      m.area[v] += ar / 3.0;
+      m.normal.row(v) += nrm.transpose();
+      m.in_mesh[static_cast<size_t>(v)] = 1;
+      m.vertex_faces[static_cast<size_t>(v)].push_back(f);
+    }
+  }
+  c /= total;
+  m.centre = c;
+  for (int v = 0; v < n; ++v) {
+    const double len = m.normal.row(v).norm();
+    if (len > 0) m.normal.row(v) /= len;
+  }
+  // The centre must be inside: most of the surface must face away from it.
+  double outward = 0;
+  for (int f = 0; f < m.F.rows(); ++f) {
+    const Eigen::Vector3d a = p.V.row(m.F(f, 0)), b = p.V.row(m.F(f, 1)), d = p.V.row(m.F(f, 2));
+    const Eigen::Vector3d nrm = (b - a).cross(d - a);
+    if (nrm.dot((a + b + d) / 3.0 - c) > 0) outward += 0.5 * nrm.norm();
+  }
+  if (outward < 0.7 * total)
+    return Status::error("skin part '" + p.name + "': only " +
+                         std::to_string(static_cast<int>(100 * outward / total)) +
+                         " % of its surface faces away from its centre of gravity (a head gives "
+                         "over 70 %): not a face, or its triangles face inward");
+
+  // Surfaces: scaled copies around c.
+  const double s = params.skull_scale;
+  const double depth[kTissueLayers] = {0, params.dermis_depth, params.hypodermis_depth, 1};
+  m.X0.resize(kTissueLayers * n, 3);
+  m.thickness.resize(n);
+  for (int v = 0; v < n; ++v) {
+    const Eigen::Vector3d p0 = p.V.row(v);
+    m.thickness[v] = (1 - s) * (p0 - c).norm();
+    for (int l = 0; l < kTissueLayers; ++l)
+      m.X0.row(m.node(l, v)) = (c + (1 - depth[l] * (1 - s)) * (p0 - c)).transpose();
+  }
+
+  // Springs, deduplicated by node pair; stiffness accumulates per prism.
+  std::unordered_map<uint64_t, int> index;
+  auto spring = [&](int a, int b, SpringKind kind, int slab) -> Spring & {
+    if (a > b) std::swap(a, b);
+    const uint64_t key = static_cast<uint64_t>(a) << 32 | static_cast<uint32_t>(b);
+    auto it = index.find(key);
+    if (it != index.end()) return m.springs[static_cast<size_t>(it->second)];
+    index.emplace(key, static_cast<int>(m.springs.size()));
+    Spring sp;
+    sp.a = a;
+    sp.b = b;
+    sp.rest = (m.X0.row(a) - m.X0.row(b)).norm();
+    sp.kind = kind;
+    sp.slab = static_cast<uint8_t>(slab);
+    sp.knee = params.slab[slab].knee;
+    sp.ratio = params.slab[slab].ratio;
+    m.springs.push_back(sp);
+    return m.springs.back();
+  };
+  auto add = [&](int a, int b, SpringKind kind, int slab, double volume) {
+    Spring &sp = spring(a, b, kind, slab);
+    if (sp.rest > 0) sp.k += volume / (sp.rest * sp.rest);
+  };
+  m.mass = Eigen::VectorXd::Zero(kTissueLayers * n);
+  const double cs = params.crossed_share;
+  for (int f = 0; f < m.F.rows(); ++f) {
+    for (int slab = 0; slab < 3; ++slab) {
+      int node[6];
+      for (int k = 0; k < 3; ++k) {
+        node[k] = m.node(slab, m.F(f, k));
+        node[3 + k] = m.node(slab + 1, m.F(f, k));
+      }
+      double vp = 0;
+      for (const auto &t : kTets)
+        vp += tet_volume(m.X0.row(node[t[0]]), m.X0.row(node[t[1]]), m.X0.row(node[t[2]]),
+                         m.X0.row(node[t[3]]));
+      vp = std::abs(vp);
+      for (int k = 0; k < 6; ++k) m.mass[node[k]] += params.density * vp / 6.0;
+      const double e = params.slab[slab].modulus;
+      for (int k = 0; k < 3; ++k) {
+        const int k2 = (k + 1) % 3;
+        const double upper = slab == 0 ? 1.0 + params.epidermis_surface : 1.0;
+        add(node[k], node[k2], SpringKind::Layer, slab, upper * e * vp * (1 - cs) / 12.0);
+        if (slab < 2)  // no springs within the bone
+          add(node[3 + k], node[3 + k2], SpringKind::Layer, slab, e * vp * (1 - cs) / 12.0);
+        add(node[k], node[3 + k], SpringKind::Connecting, slab, e * vp * (1 - cs) / 6.0);
+        add(node[k], node[3 + k2], SpringKind::Crossed, slab, e * vp * cs / 6.0);
+        add(node[k2], node[3 + k], SpringKind::Crossed, slab, e * vp * cs / 6.0);
+      }
+    }
+  }
+  m.node_springs.assign(static_cast<size_t>(kTissueLayers * n), {});
+  for (size_t i = 0; i < m.springs.size(); ++i) {
+    m.node_springs[static_cast<size_t>(m.springs[i].a)].push_back(static_cast<int>(i));
+    m.node_springs[static_cast<size_t>(m.springs[i].b)].push_back(static_cast<int>(i));
+  }
+
+  m.neighbours.assign(static_cast<size_t>(n), {});
+  for (int f = 0; f < m.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      m.neighbours[static_cast<size_t>(m.F(f, k))].push_back(m.F(f, (k + 1) % 3));
+      m.neighbours[static_cast<size_t>(m.F(f, k))].push_back(m.F(f, (k + 2) % 3));
+    }
+  for (auto &nb : m.neighbours) {
+    std::sort(nb.begin(), nb.end());
+    nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
+  }
+  m.rest_volume.resize(m.F.rows());
+  for (int f = 0; f < m.F.rows(); ++f) m.rest_volume[f] = element_volume(m, m.X0, f);
+  m.skull_free.assign(static_cast<size_t>(n), 0);
+  return m;
+}
+
+double element_volume(const SkinModel &m, const Eigen::MatrixXd &X, int f,
+                      Eigen::Matrix<double, 9, 3> *gradient) {
+  if (gradient) gradient->setZero();
+  double v = 0;
+  for (int slab = 0; slab < 3; ++slab) {
+    int node[6], row[6];
+    for (int k = 0; k < 3; ++k) {
+      node[k] = m.node(slab, m.F(f, k));
+      node[3 + k] = m.node(slab + 1, m.F(f, k));
+      row[k] = slab * 3 + k;
+      row[3 + k] = slab < 2 ? (slab + 1) * 3 + k : -1;  // skull corners: no gradient row
+    }
+    for (const auto &t : kTets) {
+      const Eigen::Vector3d p0 = X.row(node[t[0]]), p1 = X.row(node[t[1]]), p2 = X.row(node[t[2]]),
+                            p3 = X.row(node[t[3]]);
+      v += tet_volume(p0, p1, p2, p3);
+      if (!gradient) continue;
+      // d/dp1 = (p2-p0)x(p3-p0)/6 and cyclic; d/dp0 = -(sum of the others).
+      const Eigen::Vector3d g1 = (p2 - p0).cross(p3 - p0) / 6.0;
+      const Eigen::Vector3d g2 = (p3 - p0).cross(p1 - p0) / 6.0;
+      const Eigen::Vector3d g3 = (p1 - p0).cross(p2 - p0) / 6.0;
+      const Eigen::Vector3d g[4] = {-(g1 + g2 + g3), g1, g2, g3};
+      for (int c = 0; c < 4; ++c)
+        if (row[t[c]] >= 0) gradient->row(row[t[c]]) += g[c].transpose();
+    }
+  }
+  return v;
+}
+
+void element_tet_volumes(const SkinModel &m, const Eigen::MatrixXd &X, int f, double out[9]) {
+  for (int slab = 0; slab < 3; ++slab) {
+    int node[6];
+    for (int k = 0; k < 3; ++k) {
+      node[k] = m.node(slab, m.F(f, k));
+      node[3 + k] = m.node(slab + 1, m.F(f, k));
+    }
+    for (int t = 0; t < 3; ++t)
+      out[slab * 3 + t] = tet_volume(X.row(node[kTets[t][0]]), X.row(node[kTets[t][1]]),
+                                     X.row(node[kTets[t][2]]), X.row(node[kTets[t][3]]));
+  }
+}
+
+}  // namespace afmb

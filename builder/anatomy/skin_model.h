@@ -1,0 +1,128 @@
+// The multi-layer skin tissue (method paper section 2, after Lee, Terzopoulos
+// and Waters): one prismatic element per skin triangle over four surfaces,
+// mass nodes joined by nonlinear springs, a volume term per element.
+//
+// Surfaces (layers), each a copy of the skin mesh with #V nodes:
+//   0 epidermis   the input vertices;
+//   1 dermis      the dermis / fat boundary;
+//   2 hypodermis  the muscle layer, where sphincters act;
+//   3 skull       the bone, fixed (the jaw moves its part rigidly).
+// Every inner node lies on the line from its epidermal node to the skin's
+// centre of gravity c (the area-weighted centroid of the skin surface):
+//   p_k = c + (1 - d_k (1 - s)) (p_0 - c),   d = 0, dermis_depth, hypodermis_depth, 1,
+// so every surface is the epidermis scaled around c (the skull by the factor
+// s = skull_scale, as the paper makes its skull offset surface), no surface
+// intersects itself, and each element is a slice of the cone from c.
+//
+// Springs, each once however many elements share it (docs/anatomy.md has the
+// formulas):
+//   layer       along every mesh edge on layers 0, 1 and 2;
+//   connecting  from each node to the node below it (0-1, 1-2, 2-3);
+//   crossed     the two diagonals of every side face of every slab.
+// A spring's stiffness comes from the slab it belongs to (slab k lies between
+// layers k and k+1; a layer spring on layer k belongs to the slabs on both
+// sides): k = E_slab x V_share / l0^2, where V_share is its share of the slab
+// volumes it spans. So stiffness scales with size like a continuum and does
+// not depend on the mesh resolution. Biphasic: the force is linear in the
+// strain up to `knee` and `ratio` times stiffer beyond it.
+//
+// Units: positions in model units; moduli are relative (the epidermis slab's
+// modulus is 1), so forces are in "modulus x area" and only ratios matter.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "core/scene.h"
+#include "core/status.h"
+
+namespace afmb {
+
+enum TissueLayer : int { kEpidermis = 0, kDermis = 1, kHypodermis = 2, kSkull = 3 };
+constexpr int kTissueLayers = 4;
+
+struct SlabParams {
+  double modulus;  // relative Young's modulus
+  double knee;     // strain where the spring stiffens (biphasic)
+  double ratio;    // stiffness beyond the knee / below it
+};
+
+struct TissueParams {
+  double skull_scale = 0.9;       // s: skull = c + s (p0 - c); tissue is (1 - s) |p0 - c| thick
+  double dermis_depth = 0.2;      // depth of layer 1, fraction of the epidermis-to-skull line
+  double hypodermis_depth = 0.6;  // depth of layer 2
+  // Slab 0 epidermis+dermis (moderately stiff), 1 fat (soft), 2 muscle layer
+  // to the bone. The epidermal surface springs get `epidermis_surface` times
+  // slab 0's modulus on top (the keratin sheet).
+  SlabParams slab[3] = {{1.0, 0.15, 4.0}, {0.15, 0.4, 4.0}, {1.0, 0.3, 4.0}};
+  double epidermis_surface = 3.0;
+  double crossed_share = 0.5;  // share of a side face's volume given to its two diagonals
+  // Lee, Terzopoulos and Waters' volume (k_v) and shape (k_s) terms per
+  // element (solver.h gives the formulas). k_v stays small: Newton's
+  // Gauss-Newton Hessian of the volume term omits its second-order part,
+  // which slows convergence as k_v grows (measured: docs/anatomy.md).
+  double volume_modulus = 0.02;
+  double shape_modulus = 0.05;
+  double density = 1.0;        // mass per volume, for the lumped masses
+};
+
+enum class SpringKind : uint8_t { Layer, Connecting, Crossed };
+
+struct Spring {
+  int a = 0, b = 0;   // node indices (layer * n + vertex)
+  double rest = 0;    // model units
+  double k = 0;       // stiffness below the knee
+  double knee = 0;    // strain
+  double ratio = 1;   // stiffness ratio beyond the knee
+  SpringKind kind = SpringKind::Layer;
+  uint8_t slab = 0;   // 0..2; a layer spring reports its upper slab
+};
+
+struct SkinModel {
+  int part = -1;           // the scene part the skin is
+  int n = 0;               // nodes per surface (= the skin part's vertex count)
+  TissueParams params;
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // c
+  Eigen::MatrixXd X0;      // 4n x 3 rest positions, row layer * n + vertex
+  Eigen::MatrixXi F;       // #F x 3 skin triangles
+  std::vector<Spring> springs;
+  std::vector<std::vector<int>> node_springs;  // 4n: springs at each node
+  Eigen::VectorXd mass;    // 4n lumped masses
+  Eigen::VectorXd area;    // n: epidermal area per vertex (a third of each triangle)
+  Eigen::MatrixXd normal;  // n x 3: epidermal vertex normals at rest (area-weighted, unit)
+  Eigen::VectorXd thickness;  // n: epidermis to skull distance
+  Eigen::VectorXd rest_volume;  // #F: signed volume of each element (all three slabs)
+  std::vector<std::vector<int>> neighbours;    // n: vertex adjacency of the skin mesh
+  std::vector<std::vector<int>> vertex_faces;  // n: triangles at each vertex
+  // Per vertex: 1 = not tied to the bone (lips, cheeks): its springs from
+  // the hypodermis to the skull have zero stiffness and the skull does not
+  // reject its nodes.
+  std::vector<uint8_t> skull_free;
+  std::vector<uint8_t> in_mesh;  // per vertex: used by a triangle (others are never simulated)
+
+  int node(int layer, int vertex) const { return layer * n + vertex; }
+  int layer_of(int node) const { return node / n; }
+  int vertex_of(int node) const { return node % n; }
+  // The stiffness a spring has now (0 for a bone tie of a skull-free vertex).
+  double stiffness(const Spring &s) const;
+};
+
+// Builds the tissue for scene part `part`. Fails when the part has no
+// triangles, when its centre of gravity is on the surface (not a closed-ish
+// head), or when parameters are out of range (depths not 0 < d1 < d2 < 1,
+// skull_scale not in (0, 1)).
+Expected<SkinModel> build_skin_model(const Scene &scene, int part, const TissueParams &params);
+
+// Signed volume of element f (all three slabs, 9 tetrahedra) at positions X
+// (4n x 3), and optionally its gradient: 9 x 3, rows for the nodes
+// layer * 3 + corner of layers 0..2 (the skull's are not needed: it is fixed
+// or moved, never solved for).
+double element_volume(const SkinModel &m, const Eigen::MatrixXd &X, int f,
+                      Eigen::Matrix<double, 9, 3> *gradient = nullptr);
+
+// Per-tetrahedron signed volumes of element f: 9 values. An element is
+// inverted when one of its tetrahedra changed sign from the rest state.
+void element_tet_volumes(const SkinModel &m, const Eigen::MatrixXd &X, int f, double out[9]);
+
+}  // namespace afmb

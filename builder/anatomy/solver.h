@@ -1,0 +1,130 @@
+// The integrator: brings the tissue to static equilibrium under muscle forces,
+// only on a dynamic node set (method paper sections 3.2 and 3.2.4).
+//
+// Unknowns: the epidermis, dermis and hypodermis nodes (layers 0-2) of the
+// dynamic vertices, 3 coordinates each. Everything else (static vertices,
+// every skull node) stays where X has it. Forces (docs/anatomy.md):
+//   springs   biphasic, SkinModel::stiffness(); tangent stiffness
+//             T'(l) u u^T + max(T, 0) / l (I - u u^T) (compressed springs'
+//             negative geometric term dropped, so the Hessian stays SPD);
+//   volume    per element, Lee, Terzopoulos and Waters' two terms in
+//             energy form (docs/anatomy.md): E_v = k_v (V - V0)^2 / (2 |V0|),
+//             force -k_v (V - V0) / |V0| dV/dp, Hessian taken as the
+//             Gauss-Newton k_v / |V0| dV/dp dV/dp^T; and the shape term
+//             E_s = k_s |V0| / A / 2 sum_i |d_i - mean(d)|^2 over the
+//             element's 12 nodes, d = X - reference (their k2 term: each
+//             node held at its rest place relative to the element's centre),
+//             with the constant Hessian k_s |V0| / A (delta_ij - 1/12) I.
+//             `reference` is the unloaded shape: the rest state, or the
+//             rest state carried by the jaw for a jaw pose;
+//   muscles   the ForceField, a conservative load (its Hessian is left out);
+//   skull     non-penetration as a constraint: a node below the plane of
+//             its skull node (normal: the vertex's rest normal) is put back
+//             on it and may only slide along it (the constraint filter of
+//             Baraff and Witkin's modified CG). (Within one solve a node once held stays held: releasing
+//             makes the active set chatter.) Skull-free vertices and vertices whose surface faces the
+//             centre of gravity (lip curls, nostrils) are never constrained.
+//
+// Solvers:
+//   newton          Newton's method on the static equations; CG on the
+//                   sparse Hessian preconditioned by one Cholesky (LDLT)
+//                   factorisation of the rest-state Hessian of the dynamic
+//                   set, kept in a FactorCache and shared by every solve on
+//                   that set. The default.
+//   implicit-euler  the paper's scheme: Baraff-Witkin implicit Euler steps
+//                   (M (1 + h gamma) + h^2 K) dv = h (f - h K v), the modified
+//                   (constraint-filtered) CG with a Jacobi preconditioner, run
+//                   until the motion stops.
+//   newton-jacobi   Newton with a Jacobi-preconditioned CG: no factorisation.
+//
+// Stopping rule, the same for all three, with tol = SolverOptions::tolerance
+// (afm-build passes half the AFM position quantum, so the result is exact to
+// the stored grid):
+//   the last update moved no node more than tol, and the Jacobi estimate of
+//   the remaining displacement, max over unknowns |r_i| / K_ii (residual
+//   force over the diagonal stiffness), is below tol.
+// A solve that does not meet it within max_iterations, or meets a non-finite
+// number, fails: `converged` is false, X holds the last finite iterate and
+// `message` says why. Nothing in it is NaN.
+#pragma once
+
+#include <Eigen/Core>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "anatomy/skin_model.h"
+
+namespace afmb {
+
+enum class SolverKind { Newton, ImplicitEuler, NewtonJacobi };
+const char *solver_name(SolverKind kind);  // "newton", "implicit-euler", "newton-jacobi"
+bool solver_from_name(const std::string &name, SolverKind *kind);
+
+struct SolverOptions {
+  SolverKind kind = SolverKind::Newton;
+  double tolerance = 0;       // model units, > 0 (see the stopping rule)
+  int max_iterations = 0;     // Newton iterations or time steps; 0: 200 (Newton), 2000 (Euler)
+  int max_cg = 4000;          // CG iterations per linear solve
+  double cg_relative = 1e-5;  // CG stops when the preconditioned residual fell by this
+  // implicit-euler: step and mass-proportional damping in units of the
+  // system's own time t0 = sqrt(mean mass / mean stiffness diagonal).
+  double time_step = 20.0;
+  double damping = 0.5;
+};
+
+struct SolveStats {
+  bool converged = false;
+  int iterations = 0;     // Newton iterations or time steps
+  int cg_iterations = 0;  // summed over every linear solve
+  int unknowns = 0;       // 3 x free nodes
+  int contacts = 0;       // nodes held on the skull at the end
+  double residual = 0;    // the Jacobi displacement estimate at the end, model units
+  double last_step = 0;   // largest node motion of the last update, model units
+  double seconds = 0;
+  std::string message;    // why it failed; empty when converged
+};
+
+// A conservative external load: returns its potential energy at positions X
+// and, when F is given, adds its forces (4n x 3, model force units; only the
+// rows of free nodes are read). Newton's line search minimises the total
+// energy, springs + volume + this potential.
+using ForceField = std::function<double(const Eigen::MatrixXd &X, Eigen::MatrixXd *F)>;
+
+// Factorisations of rest-state Hessians, one per dynamic set, reused by every
+// solve on the same set. Not thread-safe: one cache per thread.
+class FactorCache {
+ public:
+  FactorCache();
+  ~FactorCache();
+  struct Entry;
+  Entry *find(const std::vector<int> &vertices) const;
+  Entry *insert(const std::vector<int> &vertices, std::unique_ptr<Entry> e);
+  size_t size() const { return entries_.size(); }
+  void clear();
+
+ private:
+  std::map<std::vector<int>, std::unique_ptr<Entry>> entries_;
+};
+
+// Solves for equilibrium on `vertices`, the shape term measured from `reference` (4n x 3) (sorted, unique skin vertex indices;
+// vertices in no triangle are ignored), starting from X (4n x 3; also holds
+// every fixed node) and writing the result into X. `cache` may be null for
+// the Jacobi-preconditioned solvers; newton without a cache factorises for
+// this call only.
+SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &vertices,
+                             const ForceField &forces, const Eigen::MatrixXd &reference, Eigen::MatrixXd &X,
+                             const SolverOptions &options, FactorCache *cache);
+
+// The residual force (4n x 3, zero on fixed nodes) of positions X: springs,
+// volume and `forces`, for checks and tests.
+Eigen::MatrixXd residual_forces(const SkinModel &model, const std::vector<int> &vertices,
+                                const ForceField &forces, const Eigen::MatrixXd &reference,
+                                const Eigen::MatrixXd &X);
+
+// Whether the skull rejects vertex v's nodes (see the header comment).
+bool skull_rejects(const SkinModel &model, int v);
+
+}  // namespace afmb

@@ -1,0 +1,35 @@
+// Mesh + FDP file -> a checked scene in the MPEG-4 frame, the one import
+// pipeline every builder tool runs.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/fdp.h"
+#include "core/scene.h"
+#include "core/status.h"
+#include "io/fdp_io.h"
+
+namespace afmb {
+
+struct LoadOptions {
+  std::string orient;  // --orient: "" (check only), "auto" or a spec ("x,z,-y")
+  FdpFormat fdp_format = FdpFormat::Auto;
+  bool flip_v = false;  // store 1 - v (textures whose v runs down)
+};
+
+struct LoadedFace {
+  Scene scene;
+  FdpSet fdps;  // bound to scene
+  int skin = -1;
+};
+
+// Reads the mesh and the FDPs, binds them, applies or checks the
+// orientation, assigns part kinds, repairs coincident skin vertices and
+// checks the skin. `log` gets one line per thing done on the user's behalf
+// ("orientation: applied x,z,-y", "repaired: ..."). Errors name the file and
+// line, part or FDP; an orientation error is wrapped with the mesh's path.
+Expected<LoadedFace> load_face(const std::string &mesh_path, const std::string &fdp_path,
+                               const LoadOptions &options, std::vector<std::string> *log);
+
+}  // namespace afmb

@@ -1,0 +1,248 @@
+// afm-build: mesh + FDPs -> the anatomical face model, its pictures and poses.
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "anatomy/face_model.h"
+#include "anatomy/muscle_table.h"
+#include "io/load_face.h"
+#include "render/anatomy_render.h"
+
+using namespace afmb;
+
+namespace {
+
+void usage(FILE *out) {
+  std::fprintf(out,
+      "usage: afm-build MESH FDP [options]\n"
+      "\n"
+      "Builds the anatomical face model of a face mesh and its MPEG-4 feature points\n"
+      "(docs/anatomy.md): a four-layer mass-spring skin over a skull, the 25 muscles\n"
+      "placed from the FDPs, the jaw; calibrates every muscle and prints the model.\n"
+      "Draws pictures of it and solves poses on request.\n"
+      "\n"
+      "  MESH, FDP               as afm-import (.wrl/.obj/.ply/.off/.stl; XfaceEd, text or\n"
+      "                          visage FDPs)\n"
+      "  --orient SPEC|auto      map the input axes to the MPEG-4 frame (see afm-import)\n"
+      "  --fdp-format F          auto (default), xfaceed, text or visage\n"
+      "  --flip-v                texture v runs down in this model (as afm-import)\n"
+      "  --solver S              newton (default), implicit-euler (the paper's scheme) or\n"
+      "                          newton-jacobi\n"
+      "  --no-estimates          do not estimate missing FDPs from the reference head:\n"
+      "                          muscles lacking FDPs are skipped (or, if essential, the\n"
+      "                          build fails)\n"
+      "  --no-calibrate          place muscles and jaw only (fast; for --muscle-map)\n"
+      "  --muscle-map FILE.png   muscles on the face: attachments green, insertions red,\n"
+      "                          fibres and sphincter ellipses white\n"
+      "  --influence MUSCLE FILE.png\n"
+      "                          one muscle's influence area red and the nodes its elastic\n"
+      "                          wave moves green (repeatable)\n"
+      "  --jaw-map FILE.png      skin carried by the jaw, the jaw mesh and its pivot\n"
+      "  --contract MUSCLE=PCT   contract a muscle, -100..100 %% of its calibrated range\n"
+      "                          (repeatable; positive is the muscle's action)\n"
+      "  --jaw PCT               open the jaw, 0..100 %% (100 %% is 20 degrees)\n"
+      "  --pose FILE.png         solve the pose given by --contract/--jaw and draw it\n"
+      "  --list-muscles          the 25 muscles and their key points\n"
+      "  -q, --quiet             no progress lines\n"
+      "  --help                  this text\n"
+      "\n"
+      "Exit status: 0 on success, 1 on bad input or a solve that does not converge (the\n"
+      "message says which and why), 2 on bad usage.\n");
+}
+
+int fail(const Status &s) {
+  std::fprintf(stderr, "afm-build: %s\n", s.message().c_str());
+  return 1;
+}
+
+int usage_error(const std::string &msg) {
+  std::fprintf(stderr, "afm-build: %s (see --help)\n", msg.c_str());
+  return 2;
+}
+
+}  // namespace
+
+int main(int argc, char **argv) {
+  std::string mesh_path, fdp_path, muscle_map, jaw_map, pose_png;
+  std::vector<std::pair<std::string, std::string>> influences;
+  std::vector<std::pair<std::string, double>> contractions;
+  double jaw_open = 0;
+  LoadOptions lo;
+  FaceModelOptions fo;
+  bool quiet = false, list = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto value = [&](const char *name) -> std::string {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "afm-build: %s needs a value (see --help)\n", name);
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (a == "--help" || a == "-h") {
+      usage(stdout);
+      return 0;
+    } else if (a == "--orient") {
+      lo.orient = value("--orient");
+    } else if (a == "--fdp-format") {
+      const std::string f = value("--fdp-format");
+      if (f == "auto") lo.fdp_format = FdpFormat::Auto;
+      else if (f == "xfaceed") lo.fdp_format = FdpFormat::XfaceEd;
+      else if (f == "text") lo.fdp_format = FdpFormat::Text;
+      else if (f == "visage") lo.fdp_format = FdpFormat::Visage;
+      else return usage_error("--fdp-format '" + f + "': use auto, xfaceed, text or visage");
+    } else if (a == "--flip-v") {
+      lo.flip_v = true;
+    } else if (a == "--solver") {
+      const std::string s = value("--solver");
+      if (!solver_from_name(s, &fo.solver.kind))
+        return usage_error("--solver '" + s + "': use newton, implicit-euler or newton-jacobi");
+    } else if (a == "--no-estimates") {
+      fo.estimate_missing_fdps = false;
+    } else if (a == "--no-calibrate") {
+      fo.calibrate = false;
+    } else if (a == "--muscle-map") {
+      muscle_map = value("--muscle-map");
+    } else if (a == "--influence") {
+      const std::string m = value("--influence");
+      influences.emplace_back(m, value("--influence"));
+    } else if (a == "--jaw-map") {
+      jaw_map = value("--jaw-map");
+    } else if (a == "--contract") {
+      const std::string c = value("--contract");
+      const size_t eq = c.find('=');
+      char *end = nullptr;
+      const double pct = eq == std::string::npos ? 0 : std::strtod(c.c_str() + eq + 1, &end);
+      if (eq == std::string::npos || end == c.c_str() + eq + 1 || *end)
+        return usage_error("--contract '" + c + "': use MUSCLE=PERCENT, e.g. zygomaticus_major_left=60");
+      contractions.emplace_back(c.substr(0, eq), pct);
+    } else if (a == "--jaw") {
+      const std::string v = value("--jaw");
+      char *end = nullptr;
+      jaw_open = std::strtod(v.c_str(), &end);
+      if (end == v.c_str() || *end || jaw_open < 0 || jaw_open > 100)
+        return usage_error("--jaw '" + v + "': a percentage 0..100");
+    } else if (a == "--pose") {
+      pose_png = value("--pose");
+    } else if (a == "--list-muscles") {
+      list = true;
+    } else if (a == "-q" || a == "--quiet") {
+      quiet = true;
+    } else if (a.size() > 1 && a[0] == '-') {
+      return usage_error("unknown option '" + a + "'");
+    } else if (mesh_path.empty()) {
+      mesh_path = a;
+    } else if (fdp_path.empty()) {
+      fdp_path = a;
+    } else {
+      return usage_error("too many arguments");
+    }
+  }
+  if (list) {
+    std::printf("%-26s %-9s %-36s %-26s %s\n", "muscle", "kind", "attachment / semi-major end",
+                "insertion / semi-minor end", "epicentre");
+    for (const MuscleDef &d : muscle_table())
+      std::printf("%-26s %-9s %-36s %-26s %s\n", d.name, d.kind == MuscleKind::Linear ? "linear" : "sphincter",
+                  d.attachment_or_major, d.insertion_or_minor, d.epicentre ? d.epicentre : "-");
+    if (mesh_path.empty()) return 0;
+  }
+  if (mesh_path.empty() || fdp_path.empty()) {
+    usage(stderr);
+    return 2;
+  }
+  for (const auto &[name, pct] : contractions) {
+    if (find_muscle(name) < 0) return usage_error("--contract: no muscle '" + name + "' (--list-muscles)");
+    if (pct < -100 || pct > 100) return usage_error("--contract " + name + ": percent must be within -100..100");
+  }
+  for (const auto &inf : influences)
+    if (find_muscle(inf.first) < 0) return usage_error("--influence: no muscle '" + inf.first + "' (--list-muscles)");
+  if (!pose_png.empty() && !fo.calibrate) return usage_error("--pose needs calibrated muscles (drop --no-calibrate)");
+
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<std::string> log;
+  Expected<LoadedFace> face = load_face(mesh_path, fdp_path, lo, &log);
+  for (const std::string &line : log) std::printf("%s\n", line.c_str());
+  if (!face) return fail(face.status());
+
+  if (!quiet)
+    fo.progress = [](int done, int total, const std::string &what) {
+      std::fprintf(stderr, "\r[%3d/%3d] %-40s", done, total, what.c_str());
+      if (done == total) std::fprintf(stderr, "\n");
+      std::fflush(stderr);
+    };
+  Expected<FaceModel> model = build_face_model(face->scene, face->fdps, fo);
+  if (!quiet) std::fprintf(stderr, "\n");
+  if (!model) return fail(model.status().wrap(mesh_path));
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+  const SkinModel &t = model->tissue;
+  int counts[3] = {0, 0, 0};
+  for (const Spring &s : t.springs) counts[static_cast<int>(s.kind)]++;
+  std::printf("skin: part '%s', %d vertices, %lld elements, %zu springs (layer %d, connecting %d, crossed %d)\n",
+              face->scene.parts[static_cast<size_t>(model->skin)].name.c_str(), t.n,
+              static_cast<long long>(t.F.rows()), t.springs.size(), counts[0], counts[1], counts[2]);
+  int free_count = 0;
+  for (uint8_t f : t.skull_free) free_count += f;
+  std::printf("  tissue thickness %.4g..%.4g, %d vertices not tied to the skull (lips, cheeks)\n",
+              t.thickness.minCoeff(), t.thickness.maxCoeff(), free_count);
+  std::printf("solver: %s, tolerance %.3g (half the AFM quantum %.3g), wave threshold %.3g\n",
+              solver_name(model->solver.kind), model->solver.tolerance, model->quantum, model->wave_threshold);
+  for (const std::string &n : model->notes) std::printf("note: %s\n", n.c_str());
+  for (const std::string &w : model->warnings) std::printf("warning: %s\n", w.c_str());
+  std::printf("%-26s %9s %8s %8s %11s %11s\n", "muscle", "length", "area", "V_d", "tension+", "tension-");
+  for (const Muscle &m : model->muscles)
+    std::printf("%-26s %9.4g %8zu %8zu %11.4g %11.4g\n", m.name.c_str(),
+                m.kind == MuscleKind::Linear ? m.length : m.semi_a, m.influence.size(), m.dynamic.size(),
+                m.tension_max, m.tension_min);
+  const Jaw &j = model->jaw;
+  std::printf("jaw: %zu skin vertices (%zu ray hits, %d removed and %d added by the mouth-window search), "
+              "V_d %zu, pivot (%.4g %.4g %.4g)\n",
+              j.vertices.size(), j.ray_hits.size(), j.removed, j.added, j.dynamic.size(), j.pivot.x(),
+              j.pivot.y(), j.pivot.z());
+  std::printf("built in %.2f s\n", seconds);
+
+  if (!muscle_map.empty()) {
+    if (Status s = render_muscle_map_png(face->scene, *model, muscle_map); !s) return fail(s);
+    std::printf("wrote %s\n", muscle_map.c_str());
+  }
+  for (const auto &[name, path] : influences) {
+    const int i = model->find(name);
+    if (i < 0) return fail(Status::error("--influence: muscle " + name + " was skipped (see the warnings)"));
+    if (Status s = render_influence_png(face->scene, *model, i, path); !s) return fail(s);
+    std::printf("wrote %s\n", path.c_str());
+  }
+  if (!jaw_map.empty()) {
+    if (Status s = render_jaw_map_png(face->scene, *model, jaw_map); !s) return fail(s);
+    std::printf("wrote %s\n", jaw_map.c_str());
+  }
+  if (!contractions.empty() || jaw_open > 0) {
+    Activation act;
+    for (const auto &[name, pct] : contractions) {
+      const int i = model->find(name);
+      if (i < 0) return fail(Status::error("--contract: muscle " + name + " was skipped (see the warnings)"));
+      act.muscles.emplace_back(i, pct);
+    }
+    act.jaw_open = jaw_open;
+    FactorCache cache;
+    Expected<Pose> pose = solve_pose(*model, act, &cache);
+    if (!pose) return fail(pose.status());
+    const Eigen::MatrixXd E = pose_epidermis(*model, *pose);
+    double worst = 0;
+    int at = 0;
+    for (int v = 0; v < t.n; ++v) {
+      const double d = (E.row(v) - t.X0.row(v)).norm();
+      if (d > worst) worst = d, at = v;
+    }
+    std::printf("pose: %zu dynamic vertices, %d iterations (%d CG), %.3f s; largest motion %.4g at vertex %d\n",
+                pose->dynamic.size(), pose->stats.iterations, pose->stats.cg_iterations, pose->stats.seconds,
+                worst, at);
+    if (!pose_png.empty()) {
+      if (Status s = render_pose_png(face->scene, *model, *pose, jaw_motion(model->jaw, jaw_open, 0, 0), pose_png); !s)
+        return fail(s);
+      std::printf("wrote %s\n", pose_png.c_str());
+    }
+  }
+  return 0;
+}

@@ -1,0 +1,531 @@
+// The anatomical model: physical properties, not snapshots.
+//
+// Direction tests contract one muscle of an uncalibrated model at a fixed
+// tension and solve on the whole skin (no dynamic set involved), then look at
+// the FDPs anatomy says the muscle moves.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+
+#include "anatomy/face_model.h"
+#include "anatomy/fdp_completion.h"
+#include "anatomy/muscle_table.h"
+#include "io/load_face.h"
+#include "refhead/refhead.h"
+#include "../common/test_paths.h"
+
+using namespace afmb;
+
+namespace {
+
+struct Built {
+  RefHead head;
+  FaceModel model;
+};
+
+// One reference head and its uncalibrated model, shared by the tests.
+const Built &head_1k() {
+  static std::unique_ptr<Built> b;
+  if (!b) {
+    RefHeadOptions o;
+    o.skin_vertices = 1000;
+    Expected<RefHead> h = make_reference_head(o);
+    EXPECT_TRUE(h.is_ok());
+    FaceModelOptions fo;
+    fo.calibrate = false;
+    Expected<FaceModel> m = build_face_model(h->scene, h->fdps, fo);
+    EXPECT_TRUE(m.is_ok()) << m.status().message();
+    b = std::make_unique<Built>(Built{std::move(*h), std::move(*m)});
+  }
+  return *b;
+}
+
+std::vector<int> all_vertices(const SkinModel &s) {
+  std::vector<int> v;
+  for (int i = 0; i < s.n; ++i)
+    if (s.in_mesh[static_cast<size_t>(i)]) v.push_back(i);
+  return v;
+}
+
+// Contracts muscle `name` at signed tension t on the whole skin.
+Eigen::MatrixXd contract(const FaceModel &model, const std::string &name, double t, SolveStats *stats = nullptr,
+                         SolverKind kind = SolverKind::Newton) {
+  const int i = model.find(name);
+  EXPECT_GE(i, 0) << name;
+  const Muscle &m = model.muscles[static_cast<size_t>(i)];
+  ForceField f = [&](const Eigen::MatrixXd &X, Eigen::MatrixXd *F) { return muscle_load(model.tissue, m, t, X, F); };
+  Eigen::MatrixXd X = model.tissue.X0;
+  SolverOptions so = model.solver;
+  so.kind = kind;
+  FactorCache cache;
+  SolveStats st = solve_equilibrium(model.tissue, all_vertices(model.tissue), f, model.tissue.X0, X, so, &cache);
+  EXPECT_TRUE(st.converged) << name << ": " << st.message;
+  if (stats) *stats = st;
+  return X;
+}
+
+Eigen::Vector3d moved(const FaceModel &model, const Eigen::MatrixXd &X, const char *fdp) {
+  const FdpPoint *p = model.fdps.find(*FdpId::parse(fdp), model.skin);
+  EXPECT_TRUE(p && p->part == model.skin) << fdp;
+  return X.row(p->vertex) - model.tissue.X0.row(p->vertex);
+}
+
+double mm(double metres) { return metres * 1000; }
+
+// Every element keeps the sign of each of its tetrahedra.
+// Tetrahedra seen nearly edge-on from the centre (under a thousandth of the
+// mean volume) are not judged: their sign says nothing.
+int inverted_elements(const SkinModel &s, const Eigen::MatrixXd &X) {
+  double mean = 0;
+  for (int f = 0; f < s.F.rows(); ++f) {
+    double r[9];
+    element_tet_volumes(s, s.X0, f, r);
+    for (double v : r) mean += std::abs(v) / (9.0 * static_cast<double>(s.F.rows()));
+  }
+  int bad = 0;
+  for (int f = 0; f < s.F.rows(); ++f) {
+    double r[9], c[9];
+    element_tet_volumes(s, s.X0, f, r);
+    element_tet_volumes(s, X, f, c);
+    for (int k = 0; k < 9; ++k)
+      if (std::abs(r[k]) > 1e-3 * mean && r[k] * c[k] <= 0) {
+        ++bad;
+        break;
+      }
+  }
+  return bad;
+}
+
+// Nodes of bone-tied vertices below their skull node's tangent plane.
+int penetrating_nodes(const SkinModel &s, const Eigen::MatrixXd &X, double slack) {
+  int bad = 0;
+  for (int v = 0; v < s.n; ++v) {
+    if (!s.in_mesh[static_cast<size_t>(v)] || !skull_rejects(s, v)) continue;
+    const Eigen::Vector3d n = s.normal.row(v), skull = X.row(s.node(kSkull, v));
+    for (int l = 0; l < kSkull; ++l)
+      if ((X.row(s.node(l, v)).transpose() - skull).dot(n) < -slack) ++bad;
+  }
+  return bad;
+}
+
+}  // namespace
+
+TEST(MuscleTable, TwentyFiveMusclesWithParsableKeyPoints) {
+  const auto &t = muscle_table();
+  ASSERT_EQ(t.size(), 25u);
+  int linear = 0, sphincter = 0;
+  for (const MuscleDef &d : t) {
+    (d.kind == MuscleKind::Linear ? linear : sphincter)++;
+    for (const char *text : {d.attachment_or_major, d.insertion_or_minor, d.epicentre}) {
+      if (!text) continue;
+      Expected<Keypoint> k = parse_keypoint(text);
+      ASSERT_TRUE(k.is_ok()) << d.name << ": " << k.status().message();
+    }
+    EXPECT_EQ(find_muscle(d.name), &d - t.data());
+  }
+  EXPECT_EQ(linear, 22);
+  EXPECT_EQ(sphincter, 3);
+}
+
+TEST(MuscleTable, ParserFollowsThePaperArithmetic) {
+  Expected<Keypoint> k = parse_keypoint("11.1 + 1/6 (11.3 - 11.1)");
+  ASSERT_TRUE(k.is_ok());
+  ASSERT_EQ(k->terms.size(), 2u);
+  EXPECT_EQ(k->terms[0].first.str(), "11.1");
+  EXPECT_NEAR(k->terms[0].second, 5.0 / 6.0, 1e-12);
+  EXPECT_NEAR(k->terms[1].second, 1.0 / 6.0, 1e-12);
+  // Mentalis: 2.1 + (2.1 - m), m = 8.4 + (8.4 - 9.2) -> 2 x 2.1 - 2 x 8.4 + 9.2.
+  k = parse_keypoint("2.1 + (2.1 - (8.4 + (8.4 - 9.2)))");
+  ASSERT_TRUE(k.is_ok());
+  ASSERT_EQ(k->terms.size(), 3u);
+  EXPECT_NEAR(k->terms[0].second, 2.0, 1e-12);
+  EXPECT_NEAR(k->terms[1].second, -2.0, 1e-12);
+  EXPECT_NEAR(k->terms[2].second, 1.0, 1e-12);
+  for (const char *bad : {"", "2.1 +", "1/0 (2.1)", "12.1", "2.1 - 2.2", "(2.1"})
+    EXPECT_FALSE(parse_keypoint(bad).is_ok()) << bad;
+  EXPECT_NE(parse_keypoint("2.1 - 2.2").status().message().find("not a point"), std::string::npos);
+}
+
+TEST(MuscleTable, DecisionsOnThePapersSlips) {
+  // frontalis_inner_right uses the right hairline 11.2, risorius_right starts at 5.2.
+  const MuscleDef &fr = muscle_table()[static_cast<size_t>(find_muscle("frontalis_inner_right"))];
+  EXPECT_NE(std::string(fr.attachment_or_major).find("11.2"), std::string::npos);
+  EXPECT_EQ(std::string(fr.attachment_or_major).find("11.3"), std::string::npos);
+  const MuscleDef &rr = muscle_table()[static_cast<size_t>(find_muscle("risorius_right"))];
+  EXPECT_STREQ(rr.attachment_or_major, "5.2");
+  EXPECT_STRNE(rr.attachment_or_major,
+               muscle_table()[static_cast<size_t>(find_muscle("zygomaticus_major_right"))].attachment_or_major);
+}
+
+TEST(SkinModel, FourScaledSurfacesAndResolutionFreeStiffness) {
+  const FaceModel &m = head_1k().model;
+  const SkinModel &s = m.tissue;
+  // Each inner node lies on the line to the centre, at its depth.
+  for (int v = 0; v < s.n; v += 37) {
+    const Eigen::Vector3d p0 = s.X0.row(v).transpose() - s.centre;
+    for (int l = 1; l < kTissueLayers; ++l) {
+      const Eigen::Vector3d p = s.X0.row(s.node(l, v)).transpose() - s.centre;
+      EXPECT_LT((p.normalized() - p0.normalized()).norm(), 1e-12);
+      EXPECT_LT(p.norm(), p0.norm());
+    }
+    EXPECT_NEAR((s.X0.row(s.node(kSkull, v)).transpose() - s.centre).norm(), s.params.skull_scale * p0.norm(), 1e-12);
+  }
+  int kinds[3] = {0, 0, 0};
+  for (const Spring &sp : s.springs) {
+    kinds[static_cast<int>(sp.kind)]++;
+    EXPECT_GT(sp.k, 0);
+    EXPECT_GT(sp.rest, 0);
+  }
+  // Per vertex: connecting springs to the three layers below.
+  EXPECT_EQ(kinds[static_cast<int>(SpringKind::Connecting)], 3 * static_cast<int>(all_vertices(s).size()));
+  EXPECT_GT(kinds[static_cast<int>(SpringKind::Crossed)], kinds[static_cast<int>(SpringKind::Layer)]);
+  // Under the lips and cheeks the bone ties have zero stiffness.
+  int freed = 0;
+  for (const Spring &sp : s.springs) {
+    if (sp.slab != 2 || sp.kind == SpringKind::Layer) continue;
+    const int hypo = s.layer_of(sp.a) == kHypodermis ? sp.a : sp.b;
+    if (s.skull_free[static_cast<size_t>(s.vertex_of(hypo))]) {
+      EXPECT_EQ(s.stiffness(sp), 0.0);
+      ++freed;
+    }
+  }
+  EXPECT_GT(freed, 0);
+}
+
+TEST(Muscles, AllPlacedSymmetricallyOnTheReferenceHead) {
+  const FaceModel &m = head_1k().model;
+  EXPECT_EQ(m.muscles.size(), 25u);
+  EXPECT_TRUE(m.warnings.empty());
+  for (const Muscle &mu : m.muscles) {
+    EXPECT_FALSE(mu.influence.empty()) << mu.name;
+    const std::string n = mu.name;
+    if (n.size() > 5 && n.compare(n.size() - 5, 5, "_left") == 0) {
+      const int r = m.find(n.substr(0, n.size() - 5) + "_right");
+      ASSERT_GE(r, 0) << n;
+      // The reference head is symmetric vertex for vertex.
+      EXPECT_EQ(mu.influence.size(), m.muscles[static_cast<size_t>(r)].influence.size()) << n;
+      EXPECT_NEAR(mu.length, m.muscles[static_cast<size_t>(r)].length, 1e-9) << n;
+    }
+    if (mu.kind == MuscleKind::Linear) {
+      EXPECT_EQ(m.tissue.layer_of(mu.node_a), kSkull) << n;
+      EXPECT_EQ(m.tissue.layer_of(mu.node_b), kDermis) << n;
+    } else {
+      EXPECT_EQ(m.tissue.layer_of(mu.node_a), kHypodermis) << n;
+      EXPECT_EQ(m.tissue.layer_of(mu.node_b), kHypodermis) << n;
+    }
+  }
+}
+
+TEST(Muscles, MouthWindowSearchKeepsTheLipsApart) {
+  const FaceModel &m = head_1k().model;
+  const FdpPoint *upper = m.fdps.find(*FdpId::parse("8.1"), m.skin);
+  const FdpPoint *lower = m.fdps.find(*FdpId::parse("8.2"), m.skin);
+  ASSERT_TRUE(upper && lower);
+  auto has = [](const Muscle &mu, int v) {
+    return std::binary_search(mu.influence.begin(), mu.influence.end(), v);
+  };
+  for (const char *name : {"mentalis_left", "mentalis_right"})
+    EXPECT_FALSE(has(m.muscles[static_cast<size_t>(m.find(name))], upper->vertex)) << name;
+  for (const char *name : {"upper_lip_left", "upper_lip_right"})
+    EXPECT_FALSE(has(m.muscles[static_cast<size_t>(m.find(name))], lower->vertex)) << name;
+  // The jaw carries the chin and the lower lip, not the upper lip.
+  const Jaw &j = m.jaw;
+  auto in_jaw = [&](const char *fdp) {
+    const FdpPoint *p = m.fdps.find(*FdpId::parse(fdp), m.skin);
+    return std::binary_search(j.vertices.begin(), j.vertices.end(), p->vertex);
+  };
+  EXPECT_TRUE(in_jaw("2.1"));
+  EXPECT_TRUE(in_jaw("2.10"));
+  EXPECT_TRUE(in_jaw("8.2"));
+  EXPECT_FALSE(in_jaw("8.1"));
+  EXPECT_FALSE(in_jaw("9.3"));
+}
+
+TEST(Physics, EachMuscleMovesItsRegionTheWayAnatomySays) {
+  const FaceModel &m = head_1k().model;
+  const double t = 0.05;  // a modest tension: millimetres of motion
+  {
+    const Eigen::MatrixXd X = contract(m, "zygomaticus_major_left", t);
+    const Eigen::Vector3d d = moved(m, X, "8.3");
+    const Eigen::Vector3d towards = m.fdps.find(*FdpId::parse("5.3"))->pos - m.tissue.X0.row(
+        m.fdps.find(*FdpId::parse("8.3"), m.skin)->vertex).transpose();
+    EXPECT_GT(d.y(), 0.2e-3) << "raises the corner";
+    EXPECT_GT(d.normalized().dot(towards.normalized()), 0.7) << "toward the cheekbone";
+    EXPECT_GT(mm(d.norm()), 10 * mm(moved(m, X, "8.4").norm())) << "the other corner stays";
+    EXPECT_EQ(inverted_elements(m.tissue, X), 0);
+    EXPECT_EQ(penetrating_nodes(m.tissue, X, 1e-9), 0);
+    EXPECT_TRUE(X.allFinite());
+  }
+  {
+    const Eigen::MatrixXd X = contract(m, "frontalis_major_left", t);
+    EXPECT_GT(moved(m, X, "4.3").y(), 0.2e-3) << "frontalis raises the brow";
+  }
+  {
+    const Eigen::MatrixXd X = contract(m, "corrugator_left", t);
+    const int v = m.tissue.vertex_of(m.muscles[static_cast<size_t>(m.find("corrugator_left"))].node_b);
+    const Eigen::Vector3d d = X.row(v) - m.tissue.X0.row(v);
+    EXPECT_LT(d.x(), -0.1e-3) << "corrugator pulls the (left) brow toward the midline";
+    EXPECT_GT(m.tissue.X0(v, 0), 0.0);
+  }
+  {
+    const Eigen::MatrixXd X = contract(m, "mentalis_left", t);
+    EXPECT_GT(moved(m, X, "8.2").y(), 0.1e-3) << "mentalis raises the lower lip";
+  }
+  {
+    const Eigen::MatrixXd X = contract(m, "depressor_anguli_left", t);
+    EXPECT_LT(moved(m, X, "8.3").y(), -0.2e-3) << "depressor anguli lowers the corner";
+  }
+  {
+    const Eigen::MatrixXd X = contract(m, "orbicularis_oris", t);
+    EXPECT_LT(moved(m, X, "8.3").x(), -0.2e-3) << "the left corner moves in";
+    EXPECT_GT(moved(m, X, "8.4").x(), 0.2e-3) << "the right corner moves in";
+    EXPECT_EQ(inverted_elements(m.tissue, X), 0);
+  }
+  {
+    const Eigen::MatrixXd X = contract(m, "orbicularis_oculi_left", t);
+    const double before = m.fdps.find(*FdpId::parse("3.1"))->pos.y() - m.fdps.find(*FdpId::parse("3.3"))->pos.y();
+    const double after = before + moved(m, X, "3.1").y() - moved(m, X, "3.3").y();
+    EXPECT_LT(after, before - 0.2e-3) << "orbicularis oculi narrows the eye";
+  }
+}
+
+TEST(Physics, TheJawOpens) {
+  const FaceModel &m = head_1k().model;
+  Activation a;
+  a.jaw_open = 50;
+  FactorCache cache;
+  Expected<Pose> p = solve_pose(m, a, &cache);
+  ASSERT_TRUE(p.is_ok()) << p.status().message();
+  const Eigen::Vector3d chin = moved(m, p->X, "2.1");
+  EXPECT_LT(chin.y(), -5e-3) << "the chin goes down";
+  const double gap = (p->X.row(m.fdps.find(*FdpId::parse("2.2"), m.skin)->vertex) -
+                      p->X.row(m.fdps.find(*FdpId::parse("2.3"), m.skin)->vertex)).norm();
+  EXPECT_GT(gap, 5e-3) << "the mouth opens";
+  EXPECT_LT(moved(m, p->X, "9.3").norm(), 0.1e-3) << "the nose stays";
+  EXPECT_TRUE(p->X.allFinite());
+  EXPECT_EQ(penetrating_nodes(m.tissue, p->X, 1e-9), 0);
+}
+
+TEST(Physics, ResidualBelowToleranceAtTheEnd) {
+  const FaceModel &m = head_1k().model;
+  const int i = m.find("zygomaticus_major_left");
+  const Muscle &mu = m.muscles[static_cast<size_t>(i)];
+  ForceField f = [&](const Eigen::MatrixXd &X, Eigen::MatrixXd *F) { return muscle_load(m.tissue, mu, 0.05, X, F); };
+  SolveStats st;
+  const Eigen::MatrixXd X = contract(m, "zygomaticus_major_left", 0.05, &st);
+  EXPECT_LT(st.residual, m.solver.tolerance);
+  // Independently: the net force on every free node is tiny next to the
+  // muscle's largest nodal force (skull contacts take their normal part).
+  Eigen::MatrixXd load = Eigen::MatrixXd::Zero(X.rows(), 3);
+  muscle_load(m.tissue, mu, 0.05, X, &load);
+  const Eigen::MatrixXd r = residual_forces(m.tissue, all_vertices(m.tissue), f, m.tissue.X0, X);
+  double worst = 0;
+  for (int g = 0; g < X.rows(); ++g) {
+    Eigen::Vector3d rg = r.row(g);
+    const int v = m.tissue.vertex_of(g);
+    const Eigen::Vector3d n = m.tissue.normal.row(v);
+    const double gap = (X.row(g) - X.row(m.tissue.node(kSkull, v))).dot(n);
+    if (skull_rejects(m.tissue, v) && gap < 1e-9) rg -= n * std::min(0.0, rg.dot(n));
+    worst = std::max(worst, rg.norm());
+  }
+  EXPECT_LT(worst, 1e-3 * load.rowwise().norm().maxCoeff());
+}
+
+TEST(Physics, InvariantUnderTranslationAndScalesWithTheHead) {
+  RefHeadOptions o;
+  o.skin_vertices = 1000;
+  Expected<RefHead> h = make_reference_head(o);
+  ASSERT_TRUE(h.is_ok());
+  auto displacement = [&](const Eigen::Vector3d &shift, double scale) {
+    Scene s = h->scene;
+    FdpSet f = h->fdps;
+    for (Part &p : s.parts) p.V = ((p.V * scale).rowwise() + shift.transpose()).eval();
+    for (FdpPoint &p : f.points) p.pos = p.pos * scale + shift;
+    FaceModelOptions fo;
+    fo.calibrate = false;
+    Expected<FaceModel> m = build_face_model(s, f, fo);
+    EXPECT_TRUE(m.is_ok()) << m.status().message();
+    const Eigen::MatrixXd X = contract(*m, "zygomaticus_major_left", 0.05);
+    return Eigen::MatrixXd(X.topRows(m->tissue.n) - m->tissue.X0.topRows(m->tissue.n));
+  };
+  const Eigen::MatrixXd base = displacement(Eigen::Vector3d::Zero(), 1.0);
+  const double q = head_1k().model.quantum;
+  EXPECT_LT((displacement(Eigen::Vector3d(0.3, -0.2, 0.5), 1.0) - base).cwiseAbs().maxCoeff(), q);
+  EXPECT_LT((displacement(Eigen::Vector3d::Zero(), 2.0) - 2.0 * base).cwiseAbs().maxCoeff(), 2 * q);
+  EXPECT_GT(base.cwiseAbs().maxCoeff(), 100 * q) << "the muscle moved the face";
+}
+
+TEST(Physics, DynamicSetEqualsWholeMeshWithinOneQuantum) {
+  const Built &b = head_1k();
+  FaceModelOptions fo;
+  fo.calibrate_only = {"zygomaticus_major_left"};
+  fo.calibrate_jaw = false;
+  Expected<FaceModel> m = build_face_model(b.head.scene, b.head.fdps, fo);
+  ASSERT_TRUE(m.is_ok()) << m.status().message();
+  Activation a;
+  a.muscles = {{m->find("zygomaticus_major_left"), 80.0}};
+  FactorCache cache;
+  Expected<Pose> dyn = solve_pose(*m, a, &cache);
+  ASSERT_TRUE(dyn.is_ok()) << dyn.status().message();
+  PoseOptions whole;
+  whole.whole_mesh = true;
+  Expected<Pose> all = solve_pose(*m, a, &cache, whole);
+  ASSERT_TRUE(all.is_ok()) << all.status().message();
+  EXPECT_LT(dyn->dynamic.size(), all->dynamic.size());
+  const Eigen::MatrixXd d = pose_epidermis(*m, *dyn) - pose_epidermis(*m, *all);
+  EXPECT_LE(d.cwiseAbs().maxCoeff(), m->quantum);
+  // Calibration: +80 % moves the corner 80 % of the way to the target of +100 %.
+  const Muscle &mu = m->muscles[static_cast<size_t>(m->find("zygomaticus_major_left"))];
+  const double action = muscle_action(m->tissue, mu, dyn->X);
+  EXPECT_GT(action, 0.6 * muscle_action_target(mu, true));
+  EXPECT_LT(action, 1.0 * muscle_action_target(mu, true));
+  // Uncalibrated muscles cannot be posed.
+  Activation other;
+  other.muscles = {{m->find("frontalis_major_left"), 50.0}};
+  EXPECT_FALSE(solve_pose(*m, other, &cache).is_ok());
+}
+
+TEST(Solver, ThePapersSchemeReachesTheSameEquilibrium) {
+  const FaceModel &m = head_1k().model;
+  const Eigen::MatrixXd xn = contract(m, "depressor_anguli_left", 0.05, nullptr, SolverKind::Newton);
+  const Eigen::MatrixXd xe = contract(m, "depressor_anguli_left", 0.05, nullptr, SolverKind::ImplicitEuler);
+  const Eigen::MatrixXd xj = contract(m, "depressor_anguli_left", 0.05, nullptr, SolverKind::NewtonJacobi);
+  // Each stops within its tolerance of the equilibrium; allow a few.
+  EXPECT_LT((xn - xe).cwiseAbs().maxCoeff(), 10 * m.solver.tolerance);
+  EXPECT_LT((xn - xj).cwiseAbs().maxCoeff(), 10 * m.solver.tolerance);
+}
+
+TEST(Solver, NeverReportsAnUnconvergedResultAsConverged) {
+  const FaceModel &m = head_1k().model;
+  const Muscle &mu = m.muscles[static_cast<size_t>(m.find("zygomaticus_major_left"))];
+  ForceField f = [&](const Eigen::MatrixXd &X, Eigen::MatrixXd *F) { return muscle_load(m.tissue, mu, 0.05, X, F); };
+  SolverOptions so = m.solver;
+  so.max_iterations = 1;
+  Eigen::MatrixXd X = m.tissue.X0;
+  FactorCache cache;
+  SolveStats st = solve_equilibrium(m.tissue, all_vertices(m.tissue), f, m.tissue.X0, X, so, &cache);
+  EXPECT_FALSE(st.converged);
+  EXPECT_NE(st.message.find("no equilibrium"), std::string::npos) << st.message;
+  EXPECT_TRUE(X.allFinite());
+}
+
+TEST(BadInput, NotAFaceFlippedOrMissingFdps) {
+  const Built &b = head_1k();
+  // Flipped triangles: the skin faces inward.
+  {
+    Scene s = b.head.scene;
+    Part &skin = s.parts[static_cast<size_t>(b.model.skin)];
+    skin.F.col(1).swap(skin.F.col(2));
+    Expected<FaceModel> m = build_face_model(s, b.head.fdps, FaceModelOptions{});
+    ASSERT_FALSE(m.is_ok());
+    EXPECT_NE(m.status().message().find("face inward"), std::string::npos) << m.status().message();
+  }
+  // Not a face: a flat sheet around the FDPs.
+  {
+    Scene s = b.head.scene;
+    Part &skin = s.parts[static_cast<size_t>(b.model.skin)];
+    skin.V.col(2).setZero();
+    Expected<FaceModel> m = build_face_model(s, b.head.fdps, FaceModelOptions{});
+    EXPECT_FALSE(m.is_ok());
+  }
+  // Missing FDPs without estimates: frontalis skipped naming 11.1, an
+  // essential muscle fails the build.
+  {
+    FdpSet f = b.head.fdps;
+    f.points.erase(std::remove_if(f.points.begin(), f.points.end(),
+                                  [](const FdpPoint &p) { return p.id.str() == "11.1"; }),
+                   f.points.end());
+    FaceModelOptions fo;
+    fo.calibrate = false;
+    fo.estimate_missing_fdps = false;
+    Expected<FaceModel> m = build_face_model(b.head.scene, f, fo);
+    ASSERT_TRUE(m.is_ok()) << m.status().message();
+    EXPECT_EQ(m->muscles.size(), 19u);
+    ASSERT_FALSE(m->warnings.empty());
+    EXPECT_NE(m->warnings[0].find("11.1"), std::string::npos) << m->warnings[0];
+    fo.estimate_missing_fdps = true;
+    m = build_face_model(b.head.scene, f, fo);
+    ASSERT_TRUE(m.is_ok());
+    EXPECT_EQ(m->muscles.size(), 25u);
+    ASSERT_FALSE(m->notes.empty());
+    EXPECT_NE(m->notes[0].find("FDP 11.1 absent"), std::string::npos);
+  }
+  {
+    FdpSet f = b.head.fdps;
+    f.points.erase(std::remove_if(f.points.begin(), f.points.end(),
+                                  [](const FdpPoint &p) { return p.id.str() == "5.3"; }),
+                   f.points.end());
+    FaceModelOptions fo;
+    fo.calibrate = false;
+    fo.estimate_missing_fdps = false;
+    Expected<FaceModel> m = build_face_model(b.head.scene, f, fo);
+    ASSERT_FALSE(m.is_ok());
+    EXPECT_NE(m.status().message().find("zygomaticus_major_left needs FDP 5.3"), std::string::npos)
+        << m.status().message();
+  }
+}
+
+TEST(FdpCompletion, EstimatesLandNearTheTrueFdps) {
+  // The 2000-vertex head's own FDPs, deleted and estimated from the template.
+  RefHeadOptions o;
+  o.skin_vertices = 2000;
+  Expected<RefHead> h = make_reference_head(o);
+  ASSERT_TRUE(h.is_ok());
+  const double es0 = 0.063;
+  for (const char *id : {"3.7", "11.1", "2.13", "9.15"}) {
+    FdpSet f = h->fdps;
+    const Eigen::Vector3d truth = f.find(*FdpId::parse(id))->pos;
+    f.points.erase(std::remove_if(f.points.begin(), f.points.end(),
+                                  [&](const FdpPoint &p) { return p.id.str() == id; }),
+                   f.points.end());
+    std::vector<std::string> notes;
+    Expected<std::vector<FdpId>> added = complete_fdps(h->scene, h->scene.find_kind(PartKind::Skin), f,
+                                                        {*FdpId::parse(id)}, &notes);
+    ASSERT_TRUE(added.is_ok()) << added.status().message();
+    ASSERT_EQ(added->size(), 1u);
+    EXPECT_LT((f.find(*FdpId::parse(id))->pos - truth).norm(), 0.15 * es0) << id;
+  }
+}
+
+TEST(Builds, SongHeadPlacesItsMusclesAndJaw) {
+  AFM_REQUIRE_SHARED_DATA();
+  LoadOptions lo;
+  lo.flip_v = true;
+  Expected<LoadedFace> f = load_face(afmtest::shared_data("faces/song/song.WRL"),
+                                     afmtest::shared_data("faces/song/song.fdp"), lo, nullptr);
+  ASSERT_TRUE(f.is_ok()) << f.status().message();
+  FaceModelOptions fo;
+  fo.calibrate_only = {"zygomaticus_major_left"};
+  fo.calibrate_jaw = false;
+  Expected<FaceModel> m = build_face_model(f->scene, f->fdps, fo);
+  ASSERT_TRUE(m.is_ok()) << m.status().message();
+  EXPECT_EQ(m->muscles.size(), 25u);
+  EXPECT_GE(m->notes.size(), 10u) << "Song lacks the hairline, eye corners, jaw corners...";
+  EXPECT_EQ(m->tissue.n, 2916);
+  FactorCache cache;
+  Activation a;
+  a.muscles = {{m->find("zygomaticus_major_left"), 100.0}};
+  Expected<Pose> p = solve_pose(*m, a, &cache);
+  ASSERT_TRUE(p.is_ok()) << p.status().message();
+  EXPECT_GT(moved(*m, p->X, "8.3").y(), 0) << "the smile raises Song's corner";
+  EXPECT_TRUE(p->X.allFinite());
+  // Known defect (docs/notes.md): some of Song's elements invert under this
+  // contraction (29 at 30 %, 88 at 100 %); the reference head has none.
+}
+
+TEST(Builds, ReferenceHeadAtTwoResolutions) {
+  for (int n : {1000, 3000}) {
+    RefHeadOptions o;
+    o.skin_vertices = n;
+    Expected<RefHead> h = make_reference_head(o);
+    ASSERT_TRUE(h.is_ok());
+    FaceModelOptions fo;
+    fo.calibrate_only = {"corrugator_left"};
+    Expected<FaceModel> m = build_face_model(h->scene, h->fdps, fo);
+    ASSERT_TRUE(m.is_ok()) << n << ": " << m.status().message();
+    EXPECT_EQ(m->muscles.size(), 25u);
+    EXPECT_FALSE(m->jaw.dynamic.empty());
+    EXPECT_GT(m->muscles[static_cast<size_t>(m->find("corrugator_left"))].tension_max, 0);
+  }
+}
