@@ -94,8 +94,8 @@ ForceField activation_forces(const FaceModel &model, const std::vector<std::pair
   };
 }
 
-// Finds the tension giving `target` action (section 3.3): a probe, then
-// secant steps on the action-tension curve, warm-started.
+// Finds the tension giving the +100 % (maximum) or -100 % action (section
+// 3.3): probes, then safeguarded secant steps, warm-started.
 Status calibrate_side(const FaceModel &model, Muscle &m, bool maximum, FactorCache *cache,
                       std::vector<int> &set) {
   const double target = muscle_action_target(m, maximum);
@@ -112,10 +112,10 @@ Status calibrate_side(const FaceModel &model, Muscle &m, bool maximum, FactorCac
   for (int v : m.influence) thickness += model.tissue.thickness[v];
   thickness /= static_cast<double>(m.influence.size());
   double t = 1e-2 * model.tissue.params.slab[1].modulus * std::abs(target) / thickness;
+  const ForceField f = [&](const Eigen::MatrixXd &P, Eigen::MatrixXd *F) {
+    return muscle_load(model.tissue, m, sign * t, P, F);
+  };
   for (int probe = 0; probe < 8; ++probe) {
-    ForceField f = [&](const Eigen::MatrixXd &P, Eigen::MatrixXd *F) {
-      return muscle_load(model.tissue, m, sign * t, P, F);
-    };
     X = model.tissue.X0;
     Status s = solve_growing(model, set, f, model.tissue.X0, X, coarse, coarse.tolerance, cache, false, nullptr, nullptr);
     if (!s) return s.wrap("calibrating " + m.name);
@@ -133,9 +133,6 @@ Status calibrate_side(const FaceModel &model, Muscle &m, bool maximum, FactorCac
   Eigen::MatrixXd X_lo = model.tissue.X0;
   std::string last_failure;
   for (int it = 0; it < 16; ++it) {
-    ForceField f = [&](const Eigen::MatrixXd &P, Eigen::MatrixXd *F) {
-      return muscle_load(model.tissue, m, sign * t, P, F);
-    };
     X = X_lo;
     std::vector<int> trial_set = set;
     Status s = solve_growing(model, trial_set, f, model.tissue.X0, X, coarse, coarse.tolerance, cache, false,
@@ -209,24 +206,18 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
   }
   // Section 3.2.1: the mouth-window searches take the other lip out of the
   // mentalis and upper lip areas.
-  Expected<MouthWindow> window = mouth_window(model.fdps);
-  if (!window) return window.status();
-  auto skin_vertex = [&](const char *id) {
-    const FdpPoint *p = model.fdps.find(*FdpId::parse(id), model.skin);
-    return p && p->part == model.skin ? p->vertex : -1;
-  };
-  const std::vector<int> upper_lip = mouth_window_search(model.tissue, *window, skin_vertex("2.2"));
-  const std::vector<int> lower_lip = mouth_window_search(model.tissue, *window, skin_vertex("2.3"));
+  Expected<MouthLips> lips = mouth_lips(model.tissue, model.fdps);
+  if (!lips) return lips.status();
   for (Muscle &m : model.muscles) {
-    if (m.name.rfind("mentalis", 0) == 0) remove_from_influence(m, upper_lip);
-    if (m.name.rfind("upper_lip", 0) == 0) remove_from_influence(m, lower_lip);
+    if (m.name.rfind("mentalis", 0) == 0) remove_from_influence(m, lips->upper);
+    if (m.name.rfind("upper_lip", 0) == 0) remove_from_influence(m, lips->lower);
   }
   for (const Muscle &m : model.muscles)
     if (table[static_cast<size_t>(m.def)].lips_or_cheeks)
       for (int v : m.influence) model.tissue.skull_free[static_cast<size_t>(v)] = 1;
   progress(2, steps_fixed, "muscles placed");
 
-  Expected<Jaw> jaw = build_jaw(model.tissue, model.fdps, model.fapu);
+  Expected<Jaw> jaw = build_jaw(model.tissue, model.fdps, model.fapu, *lips);
   if (!jaw) return jaw.status();
   model.jaw = std::move(*jaw);
   progress(3, steps_fixed, "jaw mapped");

@@ -4,31 +4,11 @@
 #include <cmath>
 
 #include "anatomy/muscles.h"
+#include "core/ray_triangle.h"
 
 namespace afmb {
 
-namespace {
-
-// Moeller-Trumbore: the parameter t of the segment o + t d (0 <= t <= 1) where
-// it meets triangle abc, or a negative number.
-double segment_triangle(const Eigen::Vector3d &o, const Eigen::Vector3d &d, const Eigen::Vector3d &a,
-                        const Eigen::Vector3d &b, const Eigen::Vector3d &c) {
-  const Eigen::Vector3d e1 = b - a, e2 = c - a, p = d.cross(e2);
-  const double det = e1.dot(p);
-  if (std::abs(det) < 1e-30) return -1;
-  const Eigen::Vector3d s = o - a;
-  const double u = s.dot(p) / det;
-  if (u < 0 || u > 1) return -1;
-  const Eigen::Vector3d q = s.cross(e1);
-  const double v = d.dot(q) / det;
-  if (v < 0 || u + v > 1) return -1;
-  const double t = e2.dot(q) / det;
-  return t >= 0 && t <= 1 ? t : -1;
-}
-
-}  // namespace
-
-Expected<Jaw> build_jaw(const SkinModel &skin, const FdpSet &fdps, const Fapu &fapu) {
+Expected<Jaw> build_jaw(const SkinModel &skin, const FdpSet &fdps, const Fapu &fapu, const MouthLips &lips) {
   const char *need[] = {"2.1", "2.2", "2.3", "2.4", "2.5", "2.8", "2.9", "2.11", "2.12", "2.13", "2.14", "5.3", "5.4"};
   std::string absent;
   for (const char *id : need)
@@ -60,28 +40,15 @@ Expected<Jaw> build_jaw(const SkinModel &skin, const FdpSet &fdps, const Fapu &f
     const Eigen::Vector3d o = skin.X0.row(v);
     const Eigen::Vector3d d = -2.5 * skin.thickness[v] * skin.normal.row(v).transpose();
     for (int f = 0; f < jaw.F.rows(); ++f)
-      if (segment_triangle(o, d, jaw.V.row(jaw.F(f, 0)), jaw.V.row(jaw.F(f, 1)), jaw.V.row(jaw.F(f, 2))) >= 0) {
+      if (double t; ray_triangle(o, d, jaw.V.row(jaw.F(f, 0)), jaw.V.row(jaw.F(f, 1)), jaw.V.row(jaw.F(f, 2)), &t) &&
+                    t >= 0 && t <= 1) {
         jaw.ray_hits.push_back(v);
         break;
       }
   }
 
   // The breadth-first fix of section 3.2.3.
-  Expected<MouthWindow> w = mouth_window(fdps);
-  if (!w) return w.status().wrap("jaw");
-  auto skin_vertex = [&](const char *id) {
-    const FdpPoint *p = fdps.find(*FdpId::parse(id), skin.part);
-    if (p && p->part == skin.part && p->vertex >= 0) return p->vertex;
-    int best = -1;
-    double bd = 0;
-    for (int v = 0; v < skin.n; ++v) {
-      const double dd = (skin.X0.row(v).transpose() - p->pos).squaredNorm();
-      if (skin.in_mesh[static_cast<size_t>(v)] && (best < 0 || dd < bd)) best = v, bd = dd;
-    }
-    return best;
-  };
-  const std::vector<int> upper = mouth_window_search(skin, *w, skin_vertex("2.2"));
-  const std::vector<int> lower = mouth_window_search(skin, *w, skin_vertex("2.3"));
+  const std::vector<int> &upper = lips.upper, &lower = lips.lower;
   std::vector<int> set;
   for (int v : jaw.ray_hits)
     if (!std::binary_search(upper.begin(), upper.end(), v)) set.push_back(v);

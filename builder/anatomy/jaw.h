@@ -28,6 +28,7 @@
 #include <string>
 #include <vector>
 
+#include "anatomy/muscles.h"
 #include "anatomy/skin_model.h"
 #include "core/fapu.h"
 #include "core/fdp.h"
@@ -48,8 +49,8 @@ struct Jaw {
 };
 
 // FDPs the jaw needs: 2.1-2.5, 2.8, 2.9, 2.11-2.14, 5.3, 5.4. Fails naming
-// the missing ones.
-Expected<Jaw> build_jaw(const SkinModel &skin, const FdpSet &fdps, const Fapu &fapu);
+// the missing ones. `lips` are the mouth-window searches (mouth_lips()).
+Expected<Jaw> build_jaw(const SkinModel &skin, const FdpSet &fdps, const Fapu &fapu, const MouthLips &lips);
 
 // The rigid motion for opening, thrust and shift in percent (open >= 0).
 Eigen::Affine3d jaw_motion(const Jaw &jaw, double open_pct, double thrust_pct, double shift_pct);

@@ -10,17 +10,6 @@ namespace {
 
 constexpr double kHalfPi = 1.5707963267948966;
 
-int nearest_node(const SkinModel &skin, int layer, const Eigen::Vector3d &p) {
-  int best = -1;
-  double bd = 0;
-  for (int v = 0; v < skin.n; ++v) {
-    if (!skin.in_mesh[static_cast<size_t>(v)]) continue;
-    const double d = (skin.X0.row(skin.node(layer, v)).transpose() - p).squaredNorm();
-    if (best < 0 || d < bd) best = v, bd = d;
-  }
-  return best < 0 ? -1 : skin.node(layer, best);
-}
-
 double segment_distance(const Eigen::Vector3d &p, const Eigen::Vector3d &a, const Eigen::Vector3d &b) {
   const Eigen::Vector3d ab = b - a;
   const double t = std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
@@ -152,6 +141,20 @@ std::vector<int> mouth_window_search(const SkinModel &skin, const MouthWindow &w
   }
   std::sort(out.begin(), out.end());
   return out;
+}
+
+Expected<MouthLips> mouth_lips(const SkinModel &skin, const FdpSet &fdps) {
+  Expected<MouthWindow> w = mouth_window(fdps);
+  if (!w) return w.status();
+  auto start = [&](const char *id) {
+    const FdpPoint *p = fdps.find(*FdpId::parse(id), skin.part);
+    if (p->part == skin.part && p->vertex >= 0) return p->vertex;
+    return skin.vertex_of(nearest_node(skin, kEpidermis, p->pos));
+  };
+  MouthLips lips;
+  lips.upper = mouth_window_search(skin, *w, start("2.2"));
+  lips.lower = mouth_window_search(skin, *w, start("2.3"));
+  return lips;
 }
 
 void remove_from_influence(Muscle &m, const std::vector<int> &vertices) {

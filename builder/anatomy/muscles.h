@@ -82,6 +82,14 @@ Expected<MouthWindow> mouth_window(const FdpSet &fdps);
 // vertices strictly inside the window. Returns the vertices reached, sorted.
 std::vector<int> mouth_window_search(const SkinModel &skin, const MouthWindow &w, int start);
 
+// The two searches of section 3.2.1 (and 3.2.3): from the skin vertex of FDP
+// 2.2 (else the one nearest it) the upper lip, from 2.3's the lower lip and
+// chin. Both sorted. Fails as mouth_window() does.
+struct MouthLips {
+  std::vector<int> upper, lower;
+};
+Expected<MouthLips> mouth_lips(const SkinModel &skin, const FdpSet &fdps);
+
 // Removes `vertices` (sorted) from a muscle's influence area.
 void remove_from_influence(Muscle &m, const std::vector<int> &vertices);
 

@@ -171,6 +171,17 @@ Expected<SkinModel> build_skin_model(const Scene &scene, int part, const TissueP
   return m;
 }
 
+int nearest_node(const SkinModel &m, int layer, const Eigen::Vector3d &p) {
+  int best = -1;
+  double bd = 0;
+  for (int v = 0; v < m.n; ++v) {
+    if (!m.in_mesh[static_cast<size_t>(v)]) continue;
+    const double d = (m.X0.row(m.node(layer, v)).transpose() - p).squaredNorm();
+    if (best < 0 || d < bd) best = v, bd = d;
+  }
+  return best < 0 ? -1 : m.node(layer, best);
+}
+
 double element_volume(const SkinModel &m, const Eigen::MatrixXd &X, int f,
                       Eigen::Matrix<double, 9, 3> *gradient) {
   if (gradient) gradient->setZero();

@@ -114,6 +114,10 @@ struct SkinModel {
 // skull_scale not in (0, 1)).
 Expected<SkinModel> build_skin_model(const Scene &scene, int part, const TissueParams &params);
 
+// The node of `layer` nearest p (global node index), among vertices used by
+// a triangle; -1 when there are none.
+int nearest_node(const SkinModel &m, int layer, const Eigen::Vector3d &p);
+
 // Signed volume of element f (all three slabs, 9 tetrahedra) at positions X
 // (4n x 3), and optionally its gradient: 9 x 3, rows for the nodes
 // layer * 3 + corner of layers 0..2 (the skull's are not needed: it is fixed

@@ -21,9 +21,11 @@
 //   skull     non-penetration as a constraint: a node below the plane of
 //             its skull node (normal: the vertex's rest normal) is put back
 //             on it and may only slide along it (the constraint filter of
-//             Baraff and Witkin's modified CG). (Within one solve a node once held stays held: releasing
-//             makes the active set chatter.) Skull-free vertices and vertices whose surface faces the
-//             centre of gravity (lip curls, nostrils) are never constrained.
+//             Baraff and Witkin's modified CG); within one solve a node
+//             once held stays held (releasing makes the active set
+//             chatter). Skull-free vertices and vertices whose surface
+//             faces the centre of gravity (lip curls, nostrils) are never
+//             constrained.
 //
 // Solvers:
 //   newton          Newton's method on the static equations; CG on the

@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/ray_triangle.h"
 #include "render/scene_render.h"
 
 // How the overlays are placed. The muscles' nodes lie inside the tissue
@@ -113,24 +114,6 @@ void add_outlined(std::vector<SceneMarkers> &out, const Eigen::MatrixXd &points,
   core.size_pixels = pixels;
   core.depth_bias = (float)(bias + lift);
   out.push_back(std::move(core));
-}
-
-// Möller-Trumbore: the ray o + t d meets triangle (a, b, c) at t.
-bool ray_triangle(const Eigen::Vector3d &o, const Eigen::Vector3d &d, const Eigen::Vector3d &a,
-                  const Eigen::Vector3d &b, const Eigen::Vector3d &c, double *t) {
-  const Eigen::Vector3d e1 = b - a, e2 = c - a;
-  const Eigen::Vector3d p = d.cross(e2);
-  const double det = e1.dot(p);
-  if (std::abs(det) < 1e-300) return false;
-  const double inv = 1.0 / det;
-  const Eigen::Vector3d s = o - a;
-  const double u = s.dot(p) * inv;
-  if (u < -1e-9 || u > 1 + 1e-9) return false;
-  const Eigen::Vector3d q = s.cross(e1);
-  const double v = d.dot(q) * inv;
-  if (v < -1e-9 || u + v > 1 + 1e-9) return false;
-  *t = e2.dot(q) * inv;
-  return true;
 }
 
 // The epidermis at rest, for projecting overlays onto it.

@@ -26,25 +26,16 @@ for p in map zyg jaw; do
 done
 
 # Bad usage: exit 2 with a message, nothing written.
-check_usage() {
-  name=$1 pattern=$2
-  shift 2
-  "$bin" "$@" >"$tmp/out.txt" 2>"$tmp/err.txt"
-  got=$?
-  [ "$got" -eq 2 ] || fail "$name: exit $got, expected 2"
-  grep -Eq -- "$pattern" "$tmp/err.txt" || fail "$name: message '$(cat "$tmp/err.txt")'"
-  [ -e "$tmp/bad.png" ] && fail "$name: wrote bad.png"
-}
-check_usage "no arguments" "usage: afm-build"
-check_usage "unknown muscle" "no muscle 'smile'" "$tmp/h.wrl" "$tmp/h.fdp" --contract smile=50
-check_usage "percent out of range" "within -100..100" "$tmp/h.wrl" "$tmp/h.fdp" --contract orbicularis_oris=150
-check_usage "bad contract" "MUSCLE=PERCENT" "$tmp/h.wrl" "$tmp/h.fdp" --contract orbicularis_oris
-check_usage "bad solver" "newton, implicit-euler" "$tmp/h.wrl" "$tmp/h.fdp" --solver magic
-check_usage "pose without calibration" "needs calibrated" "$tmp/h.wrl" "$tmp/h.fdp" --no-calibrate --jaw 50 --pose "$tmp/bad.png"
+h="$tmp/h.wrl" f="$tmp/h.fdp"
+expect_error "no arguments" 2 "usage: afm-build" - -- "$bin"
+expect_error "unknown muscle" 2 "no muscle 'smile'" - -- "$bin" "$h" "$f" --contract smile=50
+expect_error "percent out of range" 2 "within -100..100" - -- "$bin" "$h" "$f" --contract orbicularis_oris=150
+expect_error "bad contract" 2 "MUSCLE=PERCENT" - -- "$bin" "$h" "$f" --contract orbicularis_oris
+expect_error "bad solver" 2 "newton, implicit-euler" - -- "$bin" "$h" "$f" --solver magic
+expect_error "pose without calibration" 2 "needs calibrated" "$tmp/bad.png" -- \
+  "$bin" "$h" "$f" --no-calibrate --jaw 50 --pose "$tmp/bad.png"
 
 # Bad input: exit 1 naming the file; nothing written.
-"$bin" "$tmp/missing.wrl" "$tmp/h.fdp" --no-calibrate --muscle-map "$tmp/bad.png" >"$tmp/out.txt" 2>"$tmp/err.txt"
-[ $? -eq 1 ] || fail "a missing mesh does not exit 1"
-grep -q "missing.wrl" "$tmp/err.txt" || fail "the error does not name the mesh: $(cat "$tmp/err.txt")"
-[ -e "$tmp/bad.png" ] && fail "a failed run wrote bad.png"
+expect_error "missing mesh" 1 "missing.wrl" "$tmp/bad.png" -- \
+  "$bin" "$tmp/missing.wrl" "$f" --no-calibrate --muscle-map "$tmp/bad.png"
 finish
