@@ -1,7 +1,10 @@
 #include "anatomy/face_model.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <mutex>
+#include <thread>
 
 #include "afm/afm_export.h"
 #include "anatomy/fdp_completion.h"
@@ -59,20 +62,26 @@ double border_motion(const SkinModel &skin, const std::vector<int> &set, const E
 // Solves on `set`, growing it until the wave dies out at its border.
 Status solve_growing(const FaceModel &model, std::vector<int> &set, const ForceField &forces,
                      const Eigen::MatrixXd &reference, Eigen::MatrixXd &X, const SolverOptions &opts,
-                     double threshold, FactorCache *cache, bool whole, SolveStats *stats, int *rounds) {
+                     double threshold, FactorCache *cache, bool whole, SolveStats *stats, int *rounds,
+                     LoadControl *control = nullptr) {
   const SkinModel &skin = model.tissue;
   if (whole) {
     set.clear();
     for (int v = 0; v < skin.n; ++v)
       if (skin.in_mesh[static_cast<size_t>(v)]) set.push_back(v);
   }
-  int total_it = 0, total_cg = 0;
+  int total_it = 0, total_cg = 0, total_fact = 0;
+  double total_seconds = 0;
   for (int round = 0;; ++round) {
-    SolveStats st = solve_equilibrium(skin, set, forces, reference, X, opts, cache);
+    SolveStats st = solve_equilibrium(skin, set, forces, reference, X, opts, cache, control);
     total_it += st.iterations;
     total_cg += st.cg_iterations;
+    total_fact += st.factorisations;
+    total_seconds += st.seconds;
     st.iterations = total_it;
     st.cg_iterations = total_cg;
+    st.factorisations = total_fact;
+    st.seconds = total_seconds;
     if (stats) *stats = st;
     if (rounds) *rounds = round + 1;
     if (!st.converged) return Status::error(st.message);
@@ -94,76 +103,73 @@ ForceField activation_forces(const FaceModel &model, const std::vector<std::pair
   };
 }
 
-// Finds the tension giving the +100 % (maximum) or -100 % action (section
-// 3.3): probes, then safeguarded secant steps, warm-started.
-Status calibrate_side(const FaceModel &model, Muscle &m, bool maximum, FactorCache *cache,
-                      std::vector<int> &set) {
-  const double target = muscle_action_target(m, maximum);
-  const double sign = maximum ? 1.0 : -1.0;
-  // The search needs the action to 2 %: solve to a tenth of that, and let
-  // the wave die out to the same level (V_d is found by a strict solve later).
-  SolverOptions coarse = model.solver;
-  coarse.tolerance = std::max(model.solver.tolerance, 2e-3 * std::abs(target));
-  Eigen::MatrixXd X = model.tissue.X0;
-  // Probe: a tension small enough to stay in the linear range but moving
-  // the key node well above the tolerance; then scale to the target and
-  // take secant steps on the (stiffening) action-tension curve.
-  double thickness = 0;
-  for (int v : m.influence) thickness += model.tissue.thickness[v];
-  thickness /= static_cast<double>(m.influence.size());
-  double t = 1e-2 * model.tissue.params.slab[1].modulus * std::abs(target) / thickness;
-  const ForceField f = [&](const Eigen::MatrixXd &P, Eigen::MatrixXd *F) {
-    return muscle_load(model.tissue, m, sign * t, P, F);
+// The muscle's load at unit tension, pulling (+1) or pushing (-1).
+ForceField unit_load(const FaceModel &model, const Muscle &m, double sign) {
+  return [&model, &m, sign](const Eigen::MatrixXd &X, Eigen::MatrixXd *F) {
+    return muscle_load(model.tissue, m, sign, X, F);
   };
-  for (int probe = 0; probe < 8; ++probe) {
-    X = model.tissue.X0;
-    Status s = solve_growing(model, set, f, model.tissue.X0, X, coarse, coarse.tolerance, cache, false, nullptr, nullptr);
-    if (!s) return s.wrap("calibrating " + m.name);
-    const double a = muscle_action(model.tissue, m, X);
-    if (a * target > 0 && std::abs(a) > 0.02 * std::abs(target)) {
-      t *= std::min(target / a, 1e4);
-      break;
+}
+
+// The first guess at V_d: where the muscle's elastic wave is above half the
+// threshold at the larger of its two calibrated actions, by the rest state's
+// linear response (cheap: one factorisation per round), on the influence
+// area grown by rings until the response dies out at the set's border; plus
+// one ring. The calibration solves grow it where the nonlinear wave reaches
+// further.
+Expected<std::vector<int>> wave_estimate(const FaceModel &model, const Muscle &m) {
+  const SkinModel &skin = model.tissue;
+  Eigen::MatrixXd grad = Eigen::MatrixXd::Zero(skin.X0.rows(), 3);
+  muscle_action(skin, m, skin.X0, &grad);
+  const double reach = std::max(std::abs(muscle_action_target(m, true)), std::abs(muscle_action_target(m, false)));
+  std::vector<int> seed = m.influence;  // and the key node's vertex
+  for (Eigen::Index g = 0; g < grad.rows(); ++g)
+    if (grad.row(g).squaredNorm() > 0) seed.push_back(skin.vertex_of(static_cast<int>(g)));
+  std::sort(seed.begin(), seed.end());
+  seed.erase(std::unique(seed.begin(), seed.end()), seed.end());
+  std::vector<int> set = with_rings(skin, seed, 2);
+  for (int round = 0;; ++round) {
+    Expected<Eigen::MatrixXd> w = linear_response(skin, set, unit_load(model, m, 1.0), nullptr);
+    if (!w) return w.status();
+    const double a1 = (grad.array() * w->array()).sum();
+    if (!(std::abs(a1) > 0)) return Status::error(m.name + ": the muscle does not move its key node");
+    const Eigen::MatrixXd scaled = *w * (reach / std::abs(a1));
+    const size_t before = set.size();
+    if (border_motion(skin, set, skin.X0 + scaled) > model.wave_threshold / 2) {
+      set = with_rings(skin, set, 2 << std::min(round, 4));
+      if (set.size() > before) continue;
     }
-    t *= 10;
+    std::vector<int> out = seed;
+    for (int v : set)
+      for (int l = 0; l < kSkull; ++l)
+        if (scaled.row(skin.node(l, v)).norm() > model.wave_threshold / 2) {
+          out.push_back(v);
+          break;
+        }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return with_rings(skin, out, 1);
   }
-  // Safeguarded secant: [lo, hi] brackets the tension (hi: the action
-  // overshot, or the solve failed: too much load); steps leaving the bracket
-  // bisect it instead.
-  double lo = 0, a_lo = 0, hi = 0;
-  Eigen::MatrixXd X_lo = model.tissue.X0;
-  std::string last_failure;
-  for (int it = 0; it < 16; ++it) {
-    X = X_lo;
-    std::vector<int> trial_set = set;
-    Status s = solve_growing(model, trial_set, f, model.tissue.X0, X, coarse, coarse.tolerance, cache, false,
-                             nullptr, nullptr);
-    double a = s ? muscle_action(model.tissue, m, X) : 0.0;
-    if (s && std::abs(a - target) <= 0.02 * std::abs(target)) {
-      (maximum ? m.tension_max : m.tension_min) = t;
-      set = std::move(trial_set);
-      return Status::ok();
-    }
-    double next;
-    if (!s || std::abs(a) > std::abs(target)) {  // overshoot or failure: t is an upper bound
-      if (!s) last_failure = s.message();
-      hi = t;
-      const double guess = s && a * target > 0 && lo > 0 ? lo + (target - a_lo) * (t - lo) / (a - a_lo) : 0.0;
-      next = guess > lo && guess < hi ? guess : 0.5 * (lo + hi);
-    } else {
-      const double prev = lo, a_prev = a_lo;
-      lo = t, a_lo = a, X_lo = X, set = trial_set;
-      double guess = prev > 0 && a != a_prev ? t + (target - a) * (t - prev) / (a - a_prev)
-                                              : (a * target > 0 ? t * target / a : t * 4);
-      if (!(guess > lo) || !std::isfinite(guess)) guess = 2 * lo;
-      guess = std::min(guess, 3 * lo);
-      next = hi > 0 && guess >= hi ? 0.5 * (lo + hi) : guess;
-    }
-    t = next;
-  }
-  if (!last_failure.empty()) return Status::error("calibrating " + m.name + ": " + last_failure);
-  return Status::error("calibrating " + m.name + ": the " + (maximum ? "maximum" : "minimum") +
-                       " contraction was not found (the muscle cannot move its key node " +
-                       std::to_string(std::abs(target)) + " model units)");
+}
+
+// Finds the tension giving the +100 % (maximum) or -100 % action (section
+// 3.3): one equilibrium solve with the tension as an unknown (solver.h, load
+// control), on `set`, grown while the wave reaches its border.
+Status calibrate_side(const FaceModel &model, Muscle &m, bool maximum, FactorCache *cache, std::vector<int> &set) {
+  LoadControl control;
+  control.unit_load = unit_load(model, m, maximum ? 1.0 : -1.0);
+  control.action = [&](const Eigen::MatrixXd &X, Eigen::MatrixXd *g) { return muscle_action(model.tissue, m, X, g); };
+  control.value = muscle_action_target(m, maximum);
+  SolverOptions opts = model.solver;
+  if (opts.kind == SolverKind::ImplicitEuler) opts.kind = SolverKind::Newton;  // it cannot solve for a tension
+  Eigen::MatrixXd X = model.tissue.X0;
+  Status s = solve_growing(model, set, nullptr, model.tissue.X0, X, opts, model.wave_threshold, cache, false,
+                           nullptr, nullptr, &control);
+  if (!s)
+    return s.wrap("calibrating " + m.name + ": the " + (maximum ? "maximum" : "minimum") +
+                  " contraction (moving its key node " + std::to_string(std::abs(control.value)) +
+                  " model units) was not found");
+  (maximum ? m.tension_max : m.tension_min) = control.tension;
+  return Status::ok();
 }
 
 }  // namespace
@@ -229,35 +235,73 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
   progress(4, steps_fixed, "solver ready");
   if (!options.calibrate) return model;
 
-  FactorCache cache;
-  const int total = static_cast<int>(model.muscles.size()) + 1;
-  for (size_t i = 0; i < model.muscles.size(); ++i) {
-    Muscle &m = model.muscles[i];
-    if (!options.calibrate_only.empty() &&
-        std::find(options.calibrate_only.begin(), options.calibrate_only.end(), m.name) ==
+  // Every muscle's calibration, and the jaw's set, are independent tasks:
+  // each reads the model and writes only its own muscle, so they run on
+  // `threads` workers and give the same result on any number of them.
+  std::vector<size_t> todo;
+  for (size_t i = 0; i < model.muscles.size(); ++i)
+    if (options.calibrate_only.empty() ||
+        std::find(options.calibrate_only.begin(), options.calibrate_only.end(), model.muscles[i].name) !=
             options.calibrate_only.end())
-      continue;
-    std::vector<int> set = with_rings(model.tissue, m.influence, 1);
-    if (Status s = calibrate_side(model, m, false, &cache, set); !s) return s;
-    if (Status s = calibrate_side(model, m, true, &cache, set); !s) return s;
-    // V_d: the strict solve at +100 %, grown until the wave is below the threshold.
-    Activation full;
-    full.muscles = {{static_cast<int>(i), 100.0}};
-    m.dynamic = set;
-    Expected<Pose> p = solve_pose(model, full, &cache);
-    if (!p) return p.status().wrap("dynamic set of " + m.name);
-    m.dynamic = p->dynamic;
-    cache.clear();
-    progress(static_cast<int>(i) + 1, total, m.name);
-  }
-  if (!options.calibrate_jaw) return model;
-  Activation open;
-  open.jaw_open = 100;
+      todo.push_back(i);
+  const size_t tasks = todo.size() + (options.calibrate_jaw ? 1 : 0);
+  std::vector<Status> result(tasks);
+  Expected<Pose> jaw_pose = Status::error("jaw: not solved");
   model.jaw.dynamic = model.jaw.vertices;
-  Expected<Pose> p = solve_pose(model, open, &cache);
-  if (!p) return p.status().wrap("jaw");
-  model.jaw.dynamic = p->dynamic;
-  progress(total, total, "jaw");
+  std::atomic<size_t> next{0};
+  std::mutex lock;
+  int finished = 0;
+  const int total = static_cast<int>(tasks);
+  auto work = [&] {
+    FactorCache cache;
+    for (size_t k; (k = next++) < tasks;) {
+      std::string what = "jaw";
+      if (k < todo.size()) {
+        Muscle &m = model.muscles[todo[k]];
+        what = m.name;
+        Expected<std::vector<int>> set = wave_estimate(model, m);
+        Status s = set ? Status::ok() : set.status().wrap("calibrating " + m.name);
+        if (s) s = calibrate_side(model, m, false, &cache, *set);
+        if (s) s = calibrate_side(model, m, true, &cache, *set);
+        if (s) m.dynamic = std::move(*set);  // grown by both sides: V_d
+        result[k] = s;
+      } else {
+        Activation open;
+        open.jaw_open = 100;
+        jaw_pose = solve_pose(model, open, &cache);
+      }
+      cache.clear();
+      std::lock_guard<std::mutex> g(lock);
+      progress(++finished, total, what);
+    }
+  };
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  const size_t workers = std::min<size_t>(tasks, options.threads > 0 ? static_cast<size_t>(options.threads) : cores);
+  std::vector<std::thread> pool;
+  for (size_t w = 1; w < workers; ++w) pool.emplace_back(work);
+  work();
+  for (std::thread &t : pool) t.join();
+
+  // In table order: a muscle that cannot reach its range is skipped, as one
+  // lacking FDPs; an essential one fails the build.
+  for (size_t k = todo.size(); k-- > 0;) {
+    if (result[k]) continue;
+    const Muscle &m = model.muscles[todo[k]];
+    if (muscle_table()[static_cast<size_t>(m.def)].essential) return result[k].wrap("essential muscle");
+  }
+  std::vector<Muscle> kept;
+  for (size_t i = 0, k = 0; i < model.muscles.size(); ++i) {
+    const bool calibrated = k < todo.size() && todo[k] == i;
+    if (calibrated && !result[k++]) {
+      model.warnings.push_back(result[k - 1].message() + ": skipped");
+      continue;
+    }
+    kept.push_back(std::move(model.muscles[i]));
+  }
+  model.muscles = std::move(kept);
+  if (!options.calibrate_jaw) return model;
+  if (!jaw_pose) return jaw_pose.status().wrap("jaw");
+  model.jaw.dynamic = jaw_pose->dynamic;
   return model;
 }
 

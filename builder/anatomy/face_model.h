@@ -12,13 +12,20 @@
 // other way; in between, the tension is interpolated linearly (the motion is
 // then close to linear, not exactly: the springs are biphasic).
 //
+// Calibration (section 3.3): each side is one equilibrium solve with the
+// tension as an unknown (solver.h, load control), so the key node's action
+// is exact to the solver tolerance.
+//
 // Dynamic node sets (section 3.2.4): every solve runs on a set of skin
-// vertices; the rest stay exactly where they are. A muscle's set V_d is grown
-// from its influence area at +100 % by rings of the mesh until no vertex on
-// the set's border moves more than the wave threshold (by default the
-// solver tolerance, half an AFM quantum): the elastic wave has died out.
-// A pose solves on the union of its muscles' (and the jaw's) sets and grows
-// it again if the combination reaches further.
+// vertices; the rest stay exactly where they are. A muscle's set V_d starts
+// from the rest state's linear response (where the wave at the larger
+// calibrated action exceeds half the wave threshold, found on the influence
+// area grown by rings until the response dies out at its border), and both
+// calibration solves grow it by rings until no vertex on the set's border
+// moves more than the wave threshold (by default the solver tolerance, half
+// an AFM quantum): the elastic wave has died out. A pose solves on the union
+// of its muscles' (and the jaw's) sets and grows it again if the combination
+// reaches further.
 #pragma once
 
 #include <Eigen/Core>
@@ -47,7 +54,13 @@ struct FaceModelOptions {
   // tools that need a few muscles of a big model.
   std::vector<std::string> calibrate_only;
   bool calibrate_jaw = true;
+  // Workers for the calibration (muscles and the jaw are independent); 0: one
+  // per core. The model is the same whatever the number.
+  int threads = 0;
   // Called after each step of the build: done of total, and what was done.
+  // The placement steps come first (1..4 of 4), then the calibration tasks
+  // (1..N of N, in the order they finish; from the worker threads, one call
+  // at a time).
   std::function<void(int done, int total, const std::string &what)> progress;
 };
 
@@ -62,7 +75,7 @@ struct FaceModel {
   SolverOptions solver;          // tolerance filled in
   double wave_threshold = 0;
   std::vector<std::string> notes;     // FDP estimates
-  std::vector<std::string> warnings;  // skipped muscles, naming their FDPs
+  std::vector<std::string> warnings;  // skipped muscles: the FDPs they lack, or why calibration failed
 
   int find(const std::string &muscle) const;  // index into muscles, or -1
 };
@@ -71,7 +84,9 @@ struct FaceModel {
 // (non-manifold, degenerate), FDPs not in the MPEG-4 frame
 // (check_orientation), a skin facing inward or not wrapping its centre (not
 // a face), a missing FDP of an essential muscle or of the jaw, and a
-// calibration that does not converge.
+// calibration of an essential muscle or of the jaw that does not converge.
+// A muscle that is not essential and lacks FDPs or cannot be calibrated is
+// left out of `muscles`, with a line in `warnings` saying why.
 Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &fdps,
                                      const FaceModelOptions &options);
 

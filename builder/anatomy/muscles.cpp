@@ -185,6 +185,19 @@ double muscle_load(const SkinModel &skin, const Muscle &m, double tension, const
       energy -= s * m.weight[i] * (X.row(node).transpose() - x0).dot(u);
       if (F) F->row(node) += (s * m.weight[i]) * u.transpose();
     }
+  } else if (s < 0) {
+    // Widening: a dead load outward along the rest direction from the
+    // epicentre. A push away from the moving epicentre direction would be
+    // unstable around it (negative stiffness across the radius).
+    for (size_t i = 0; i < m.influence.size(); ++i) {
+      const int node = skin.node(m.force_layer, m.influence[i]);
+      const Eigen::Vector3d x0 = skin.X0.row(node);
+      const Eigen::Vector3d d0(x0.x() - m.epicentre.x(), x0.y() - m.epicentre.y(), 0.0);
+      if (!(d0.norm() > 0)) continue;
+      const Eigen::Vector3d u = d0.normalized();
+      energy -= -s * m.weight[i] * (X.row(node).transpose() - x0).dot(u);
+      if (F) F->row(node) += (-s * m.weight[i]) * u.transpose();
+    }
   } else {
     const double floor = m.semi_b / 3;
     for (size_t i = 0; i < m.influence.size(); ++i) {
@@ -198,17 +211,21 @@ double muscle_load(const SkinModel &skin, const Muscle &m, double tension, const
   return energy;
 }
 
-double muscle_action(const SkinModel &skin, const Muscle &m, const Eigen::MatrixXd &X) {
+double muscle_action(const SkinModel &skin, const Muscle &m, const Eigen::MatrixXd &X, Eigen::MatrixXd *gradient) {
   if (m.kind == MuscleKind::Linear) {
     const Eigen::Vector3d a0 = skin.X0.row(m.node_a), b0 = skin.X0.row(m.node_b), b = X.row(m.node_b);
-    return m.sense * (b - b0).dot((a0 - b0).normalized());
+    const Eigen::Vector3d dir = m.sense * (a0 - b0).normalized();
+    if (gradient) gradient->row(m.node_b) += dir.transpose();
+    return (b - b0).dot(dir);
   }
   const bool minor = muscle_table()[static_cast<size_t>(m.def)].calibrate_minor;
   const int node = minor ? m.node_b : m.node_a;
-  auto dist = [&](const Eigen::MatrixXd &P) {
-    return std::hypot(P(node, 0) - m.epicentre.x(), P(node, 1) - m.epicentre.y());
+  auto offset = [&](const Eigen::MatrixXd &P) {
+    return Eigen::Vector2d(P(node, 0) - m.epicentre.x(), P(node, 1) - m.epicentre.y());
   };
-  return dist(skin.X0) - dist(X);
+  const Eigen::Vector2d d = offset(X);
+  if (gradient && d.norm() > 0) gradient->row(node).head<2>() -= d.normalized().transpose();
+  return offset(skin.X0).norm() - d.norm();
 }
 
 double muscle_action_target(const Muscle &m, bool maximum) {

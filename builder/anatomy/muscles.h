@@ -98,16 +98,20 @@ void remove_from_influence(Muscle &m, const std::vector<int> &vertices);
 // is conservative: a linear muscle's pull is a dead load along the rest
 // direction u0 from the node to A, potential -t sense w (p - p0) . u0 (a
 // push away from a moving point would be unstable across the fibre); a
-// sphincter's t sense w h(|d.xy|), h(r) = r beyond the
-// floor b / 3 and r^2 / (2 floor) + floor / 2 within it.
+// sphincter's, contracting (t sense > 0), t sense w h(|d.xy|) with d the
+// node's offset from the epicentre, h(r) = r beyond the floor b / 3 and
+// r^2 / (2 floor) + floor / 2 within it; widening, a dead load outward
+// along the rest offset, for the same reason as the linear push.
 double muscle_load(const SkinModel &skin, const Muscle &m, double tension, const Eigen::MatrixXd &X,
                    Eigen::MatrixXd *F);
 
 // How far the muscle has acted at positions X (model units, positive in the
 // direction of its action): linear, the insertion's motion along the fibre
 // toward the attachment times sense; sphincter, the calibrated semi-axis
-// node's motion toward the epicentre in the x-y plane.
-double muscle_action(const SkinModel &skin, const Muscle &m, const Eigen::MatrixXd &X);
+// node's motion toward the epicentre in the x-y plane. When `gradient` is
+// given, adds the action's gradient with respect to X (4n x 3) to it.
+double muscle_action(const SkinModel &skin, const Muscle &m, const Eigen::MatrixXd &X,
+                     Eigen::MatrixXd *gradient = nullptr);
 // The action at +100 % (positive) and at -100 % (negative) contraction.
 double muscle_action_target(const Muscle &m, bool maximum);
 

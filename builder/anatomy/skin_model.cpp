@@ -211,6 +211,49 @@ double element_volume(const SkinModel &m, const Eigen::MatrixXd &X, int f,
   return v;
 }
 
+void element_volume_hessian(const SkinModel &m, const Eigen::MatrixXd &X, int f, Eigen::Matrix<double, 27, 27> *H) {
+  H->setZero();
+  auto skew = [](const Eigen::Vector3d &v) {
+    Eigen::Matrix3d s;
+    s << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+    return s;
+  };
+  for (int slab = 0; slab < 3; ++slab) {
+    int node[6], row[6];
+    for (int k = 0; k < 3; ++k) {
+      node[k] = m.node(slab, m.F(f, k));
+      node[3 + k] = m.node(slab + 1, m.F(f, k));
+      row[k] = slab * 3 + k;
+      row[3 + k] = slab < 2 ? (slab + 1) * 3 + k : -1;
+    }
+    for (const auto &t : kTets) {
+      // V = a . (b x c) / 6 with a, b, c = p1 - p0, p2 - p0, p3 - p0: its
+      // second derivatives in (a, b, c) are skew blocks, zero on the diagonal.
+      const Eigen::Vector3d p0 = X.row(node[t[0]]);
+      const Eigen::Vector3d e[3] = {X.row(node[t[1]]).transpose() - p0, X.row(node[t[2]]).transpose() - p0,
+                                    X.row(node[t[3]]).transpose() - p0};
+      Eigen::Matrix3d h[3][3];
+      h[0][0] = h[1][1] = h[2][2] = Eigen::Matrix3d::Zero();
+      h[0][1] = -skew(e[2]) / 6, h[0][2] = skew(e[1]) / 6, h[1][2] = -skew(e[0]) / 6;
+      h[1][0] = h[0][1].transpose(), h[2][0] = h[0][2].transpose(), h[2][1] = h[1][2].transpose();
+      // Points: p_{k+1} moves edge k; p0 moves all three edges the other way.
+      for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j) {
+          const int ri = row[t[i]], rj = row[t[j]];
+          if (ri < 0 || rj < 0) continue;
+          Eigen::Matrix3d b = Eigen::Matrix3d::Zero();
+          for (int a = 0; a < 3; ++a)
+            for (int c = 0; c < 3; ++c) {
+              const double sa = i == 0 ? -1.0 : (i == a + 1 ? 1.0 : 0.0);
+              const double sc = j == 0 ? -1.0 : (j == c + 1 ? 1.0 : 0.0);
+              if (sa != 0 && sc != 0) b += sa * sc * h[a][c];
+            }
+          H->block<3, 3>(3 * ri, 3 * rj) += b;
+        }
+    }
+  }
+}
+
 void element_tet_volumes(const SkinModel &m, const Eigen::MatrixXd &X, int f, double out[9]) {
   for (int slab = 0; slab < 3; ++slab) {
     int node[6];

@@ -59,11 +59,10 @@ struct TissueParams {
   double epidermis_surface = 3.0;
   double crossed_share = 0.5;  // share of a side face's volume given to its two diagonals
   // Lee, Terzopoulos and Waters' volume (k_v) and shape (k_s) terms per
-  // element (solver.h gives the formulas). k_v stays small: Newton's
-  // Gauss-Newton Hessian of the volume term omits its second-order part,
-  // which slows convergence as k_v grows (measured: docs/anatomy.md).
+  // element (solver.h gives the formulas; docs/anatomy.md how they were
+  // chosen).
   double volume_modulus = 0.02;
-  double shape_modulus = 0.05;
+  double shape_modulus = 0.1;
   double density = 1.0;        // mass per volume, for the lumped masses
 };
 
@@ -124,6 +123,11 @@ int nearest_node(const SkinModel &m, int layer, const Eigen::Vector3d &p);
 // or moved, never solved for).
 double element_volume(const SkinModel &m, const Eigen::MatrixXd &X, int f,
                       Eigen::Matrix<double, 9, 3> *gradient = nullptr);
+
+// The Hessian of element_volume(): 27 x 27, the 3 x 3 block (i, j) for the
+// gradient rows i and j (layers 0..2). Indefinite (the volume is cubic in
+// the positions).
+void element_volume_hessian(const SkinModel &m, const Eigen::MatrixXd &X, int f, Eigen::Matrix<double, 27, 27> *H);
 
 // Per-tetrahedron signed volumes of element f: 9 values. An element is
 // inverted when one of its tetrahedra changed sign from the rest state.

@@ -4,64 +4,28 @@
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 
 namespace afmb {
-
-struct FactorCache::Entry {
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower> ldlt;
-  bool ok = false;
-};
-
-FactorCache::FactorCache() = default;
-FactorCache::~FactorCache() = default;
-FactorCache::Entry *FactorCache::find(const std::vector<int> &vertices) const {
-  auto it = entries_.find(vertices);
-  return it == entries_.end() ? nullptr : it->second.get();
-}
-FactorCache::Entry *FactorCache::insert(const std::vector<int> &vertices, std::unique_ptr<Entry> e) {
-  Entry *raw = e.get();
-  entries_[vertices] = std::move(e);
-  return raw;
-}
-void FactorCache::clear() { entries_.clear(); }
-
-const char *solver_name(SolverKind kind) {
-  switch (kind) {
-    case SolverKind::Newton: return "newton";
-    case SolverKind::ImplicitEuler: return "implicit-euler";
-    case SolverKind::NewtonJacobi: return "newton-jacobi";
-  }
-  return "?";
-}
-
-bool solver_from_name(const std::string &name, SolverKind *kind) {
-  for (SolverKind k : {SolverKind::Newton, SolverKind::ImplicitEuler, SolverKind::NewtonJacobi})
-    if (name == solver_name(k)) {
-      *kind = k;
-      return true;
-    }
-  return false;
-}
-
-bool skull_rejects(const SkinModel &m, int v) {
-  if (m.skull_free[static_cast<size_t>(v)]) return false;
-  const Eigen::Vector3d out = m.X0.row(v).transpose() - m.centre;
-  return m.normal.row(v).dot(out) > 0.3 * out.norm();
-}
 
 namespace {
 
 using Vec = Eigen::VectorXd;
 using SpMat = Eigen::SparseMatrix<double>;
+using Ldlt = Eigen::SimplicialLDLT<SpMat, Eigen::Lower>;
 
 // Elements whose rest volume is this small relative to the mean are left out
 // of the volume term: seen edge-on from the centre, their volume says nothing.
 constexpr double kVolumeFloor = 1e-3;
-// Newton refactorises the tangent when a linear solve needed more CG
-// iterations than this with the current preconditioner.
-constexpr int kRefactorAfter = 30;
+
+// A 3x3 block of the Hessian inside the CSC value array: entry (r, c) is at
+// base + c * stride + r. base < 0: the block is not stored (a fixed node).
+struct Block {
+  int base = -1, stride = 0;
+};
 
 struct Element {
   int f;
@@ -71,6 +35,9 @@ struct Element {
   double shape;   // shape term: k_s |V0| / area
 };
 
+// The unknowns of one dynamic set and the fixed sparsity of their Hessian:
+// 3x3 blocks between nodes joined by a spring or sharing an element. Built
+// once per set; every linearisation writes values into the same pattern.
 struct System {
   const SkinModel &m;
   std::vector<int> nodes;  // free nodes, global
@@ -78,7 +45,18 @@ struct System {
   std::vector<int> springs;
   std::vector<Element> elements;
   std::vector<uint8_t> rejects;  // per local node
+  std::vector<std::vector<int>> adj;  // per local node: sorted block neighbours (itself included)
+  std::vector<std::array<Block, 4>> spring_blocks;  // aa, bb, ab, ba
+  std::vector<Block> element_blocks;                // 81 per element, (i, j) at 9 i + j
+  std::vector<Block> diagonal;                      // per local node
+  SpMat pattern;                                    // dofs x dofs, values unset
   int dofs() const { return 3 * static_cast<int>(nodes.size()); }
+
+  Block block(int i, int j) const {
+    const std::vector<int> &col = adj[static_cast<size_t>(j)];
+    const auto pos = std::lower_bound(col.begin(), col.end(), i) - col.begin();
+    return Block{pattern.outerIndexPtr()[3 * j] + 3 * static_cast<int>(pos), 3 * static_cast<int>(col.size())};
+  }
 
   System(const SkinModel &model, const std::vector<int> &vertices) : m(model) {
     local.assign(static_cast<size_t>(kTissueLayers * m.n), -1);
@@ -118,13 +96,73 @@ struct System {
             if (l < kSkull) e.local[l * 3 + k] = local[static_cast<size_t>(e.global[l * 3 + k])];
           }
         e.weight = v0 < kVolumeFloor * mean ? 0.0 : m.params.volume_modulus / v0;
-        const Eigen::Vector3d a = m.X0.row(e.global[0]), b = m.X0.row(e.global[1]), c = m.X0.row(e.global[2]);
-        const double area = 0.5 * (b - a).cross(c - a).norm();
-        e.shape = area > 0 ? m.params.shape_modulus * v0 / area : 0.0;
+        // Divided by the element's squared radius of gyration at rest, the
+        // shape energy is modulus x volume x (relative displacement / size)^2:
+        // a strain energy, the same at every mesh resolution.
+        Eigen::Matrix<double, 12, 3> p;
+        for (int k = 0; k < 12; ++k) p.row(k) = m.X0.row(e.global[k]);
+        const double gyration2 = (p.rowwise() - p.colwise().mean()).squaredNorm() / 12.0;
+        e.shape = gyration2 > 0 ? m.params.shape_modulus * v0 / gyration2 : 0.0;
         elements.push_back(e);
       }
     }
     std::sort(elements.begin(), elements.end(), [](const Element &a, const Element &b) { return a.f < b.f; });
+    build_pattern();
+  }
+
+  void build_pattern() {
+    const int nn = static_cast<int>(nodes.size());
+    adj.assign(static_cast<size_t>(nn), {});
+    for (int i = 0; i < nn; ++i) adj[static_cast<size_t>(i)].push_back(i);
+    auto link = [&](int i, int j) {
+      if (i < 0 || j < 0 || i == j) return;
+      adj[static_cast<size_t>(i)].push_back(j);
+    };
+    for (int si : springs) {
+      const Spring &s = m.springs[static_cast<size_t>(si)];
+      const int a = local[static_cast<size_t>(s.a)], b = local[static_cast<size_t>(s.b)];
+      link(a, b), link(b, a);
+    }
+    for (const Element &e : elements)
+      for (int i = 0; i < 9; ++i)
+        for (int j = 0; j < 9; ++j) link(e.local[i], e.local[j]);
+    Eigen::Index nnz = 0;
+    for (auto &a : adj) {
+      std::sort(a.begin(), a.end());
+      a.erase(std::unique(a.begin(), a.end()), a.end());
+      nnz += 9 * static_cast<Eigen::Index>(a.size());
+    }
+    const int n = dofs();
+    pattern.resize(n, n);
+    pattern.resizeNonZeros(nnz);
+    int *outer = pattern.outerIndexPtr(), *inner = pattern.innerIndexPtr();
+    int k = 0;
+    for (int j = 0; j < nn; ++j)
+      for (int c = 0; c < 3; ++c) {
+        outer[3 * j + c] = k;
+        for (int i : adj[static_cast<size_t>(j)])
+          for (int r = 0; r < 3; ++r) inner[k++] = 3 * i + r;
+      }
+    outer[n] = k;
+    std::fill(pattern.valuePtr(), pattern.valuePtr() + nnz, 0.0);
+    diagonal.resize(static_cast<size_t>(nn));
+    for (int i = 0; i < nn; ++i) diagonal[static_cast<size_t>(i)] = block(i, i);
+    spring_blocks.resize(springs.size());
+    for (size_t q = 0; q < springs.size(); ++q) {
+      const Spring &s = m.springs[static_cast<size_t>(springs[q])];
+      const int a = local[static_cast<size_t>(s.a)], b = local[static_cast<size_t>(s.b)];
+      std::array<Block, 4> &bl = spring_blocks[q];
+      if (a >= 0) bl[0] = block(a, a);
+      if (b >= 0) bl[1] = block(b, b);
+      if (a >= 0 && b >= 0) bl[2] = block(a, b), bl[3] = block(b, a);
+    }
+    element_blocks.resize(81 * elements.size());
+    for (size_t e = 0; e < elements.size(); ++e)
+      for (int i = 0; i < 9; ++i)
+        for (int j = 0; j < 9; ++j) {
+          const int li = elements[e].local[i], lj = elements[e].local[j];
+          if (li >= 0 && lj >= 0) element_blocks[81 * e + static_cast<size_t>(9 * i + j)] = block(li, lj);
+        }
   }
 };
 
@@ -162,75 +200,61 @@ double spring_energy(const Spring &s, double k, double l) {
   return k * s.rest * s.rest * u;
 }
 
-// State of one linearisation: the spring Hessian, the volume gradients.
-struct Linearisation {
-  SpMat K;                 // springs only, dofs x dofs, PSD
-  std::vector<Eigen::Matrix<double, 9, 3>> grad;  // per element
-  Vec diag;                // diagonal of the whole Hessian (springs + volume)
-};
+template <class M>
+void add_block(double *values, Block b, const M &B) {
+  for (int c = 0; c < 3; ++c)
+    for (int r = 0; r < 3; ++r) values[b.base + c * b.stride + r] += B(r, c);
+}
 
-void linearise(const System &sys, const Eigen::MatrixXd &X, Linearisation &lin) {
+// The Hessian at X into K (the system's pattern): springs, the shape term and
+// the volume term. `diag` gets its diagonal. `projected`: the indefinite
+// parts are dropped (a compressed spring's negative transverse stiffness,
+// the volume's own curvature k_v (V - V0) / |V0| d2V/dp2, leaving its
+// Gauss-Newton part), which keeps K positive semi-definite everywhere; kept,
+// Newton converges quadratically near an equilibrium, where K is definite
+// anyway.
+void linearise(const System &sys, const Eigen::MatrixXd &X, SpMat &K, Vec &diag, double curvature = 0) {
   const SkinModel &m = sys.m;
-  const int n = sys.dofs();
-  std::vector<Eigen::Triplet<double>> trip;
-  trip.reserve(sys.springs.size() * 36);
-  for (int si : sys.springs) {
-    const Spring &s = m.springs[static_cast<size_t>(si)];
+  if (K.nonZeros() != sys.pattern.nonZeros()) K = sys.pattern;
+  double *val = K.valuePtr();
+  std::fill(val, val + K.nonZeros(), 0.0);
+  for (size_t q = 0; q < sys.springs.size(); ++q) {
+    const Spring &s = m.springs[static_cast<size_t>(sys.springs[q])];
     const Eigen::Vector3d d = X.row(s.b) - X.row(s.a);
     const double l = std::max(d.norm(), 1e-12 * s.rest);
     const Eigen::Vector3d u = d / l;
     double t, dt;
     tension(s, m.stiffness(s), l, &t, &dt);
-    const Eigen::Matrix3d B =
-        dt * u * u.transpose() + std::max(t, 0.0) / l * (Eigen::Matrix3d::Identity() - u * u.transpose());
-    const int la = sys.local[static_cast<size_t>(s.a)], lb = sys.local[static_cast<size_t>(s.b)];
-    const int ends[2] = {la, lb};
-    for (int i = 0; i < 2; ++i)
-      for (int j = 0; j < 2; ++j) {
-        if (ends[i] < 0 || ends[j] < 0) continue;
-        const double sign = i == j ? 1.0 : -1.0;
-        for (int r = 0; r < 3; ++r)
-          for (int c = 0; c < 3; ++c) trip.emplace_back(3 * ends[i] + r, 3 * ends[j] + c, sign * B(r, c));
-      }
+    const double geo = (t >= 0 ? t : curvature * t) / l;
+    const Eigen::Matrix3d B = (dt - geo) * u * u.transpose() + geo * Eigen::Matrix3d::Identity();
+    const std::array<Block, 4> &bl = sys.spring_blocks[q];
+    if (bl[0].base >= 0) add_block(val, bl[0], B);
+    if (bl[1].base >= 0) add_block(val, bl[1], B);
+    if (bl[2].base >= 0) add_block(val, bl[2], -B), add_block(val, bl[3], -B);
   }
-  // Shape term: k_s (delta_ij - 1/12) I per pair of the element's free nodes.
-  for (const Element &el : sys.elements) {
-    if (el.shape <= 0) continue;
+  Eigen::Matrix<double, 9, 3> g;
+  Eigen::Matrix<double, 27, 27> H;
+  for (size_t e = 0; e < sys.elements.size(); ++e) {
+    const Element &el = sys.elements[e];
+    double excess = 0;  // k_v (V - V0) / |V0|: the weight of the volume's own curvature
+    if (el.weight > 0) {
+      excess = curvature * el.weight * (element_volume(m, X, el.f, &g) - m.rest_volume[el.f]);
+      if (excess != 0) element_volume_hessian(m, X, el.f, &H);
+    }
     for (int i = 0; i < 9; ++i)
       for (int j = 0; j < 9; ++j) {
-        if (el.local[i] < 0 || el.local[j] < 0) continue;
-        const double v = el.shape * ((i == j ? 1.0 : 0.0) - 1.0 / 12.0);
-        for (int k = 0; k < 3; ++k) trip.emplace_back(3 * el.local[i] + k, 3 * el.local[j] + k, v);
+        const Block b = sys.element_blocks[81 * e + static_cast<size_t>(9 * i + j)];
+        if (b.base < 0) continue;
+        Eigen::Matrix3d B = Eigen::Matrix3d::Identity() * (el.shape * ((i == j ? 1.0 : 0.0) - 1.0 / 12.0));
+        if (el.weight > 0) B.noalias() += el.weight * g.row(i).transpose() * g.row(j);
+        if (excess != 0) B += excess * H.block<3, 3>(3 * i, 3 * j);
+        add_block(val, b, B);
       }
   }
-  lin.K.resize(n, n);
-  lin.K.setFromTriplets(trip.begin(), trip.end());
-  lin.diag = lin.K.diagonal();
-  lin.grad.resize(sys.elements.size());
-  for (size_t e = 0; e < sys.elements.size(); ++e) {
-    const Element &el = sys.elements[e];
-    if (el.weight == 0) {
-      lin.grad[e].setZero();
-      continue;
-    }
-    element_volume(m, X, el.f, &lin.grad[e]);
-    for (int r = 0; r < 9; ++r)
-      if (el.local[r] >= 0)
-        for (int k = 0; k < 3; ++k) lin.diag[3 * el.local[r] + k] += el.weight * lin.grad[e](r, k) * lin.grad[e](r, k);
-  }
-}
-
-// out = K p (springs and the Gauss-Newton volume term).
-void hessian_times(const System &sys, const Linearisation &lin, const Vec &p, Vec &out) {
-  out.noalias() = lin.K * p;
-  for (size_t e = 0; e < sys.elements.size(); ++e) {
-    const Element &el = sys.elements[e];
-    double dot = 0;
-    for (int r = 0; r < 9; ++r)
-      if (el.local[r] >= 0) dot += lin.grad[e].row(r).dot(p.segment<3>(3 * el.local[r]));
-    dot *= el.weight;
-    for (int r = 0; r < 9; ++r)
-      if (el.local[r] >= 0) out.segment<3>(3 * el.local[r]) += dot * lin.grad[e].row(r).transpose();
+  diag.resize(sys.dofs());
+  for (size_t i = 0; i < sys.diagonal.size(); ++i) {
+    const Block b = sys.diagonal[i];
+    for (int r = 0; r < 3; ++r) diag[3 * static_cast<Eigen::Index>(i) + r] = val[b.base + r * b.stride + r];
   }
 }
 
@@ -274,6 +298,13 @@ void net_force(const System &sys, const ForceField &forces, const Eigen::MatrixX
   }
 }
 
+// The rows of a 4n x 3 field at the free nodes, as a dofs vector.
+Vec gather_rows(const System &sys, const Eigen::MatrixXd &F) {
+  Vec v(sys.dofs());
+  for (size_t i = 0; i < sys.nodes.size(); ++i) v.segment<3>(3 * static_cast<int>(i)) = F.row(sys.nodes[i]).transpose();
+  return v;
+}
+
 // Total potential energy of the system: springs, volume, external load.
 double total_energy(const System &sys, const ForceField &forces, const Eigen::MatrixXd &ref,
                     const Eigen::MatrixXd &X) {
@@ -310,6 +341,30 @@ struct Contacts {
       if (nn.squaredNorm() == 0) continue;
       Eigen::Ref<Vec> s = v.segment(3 * i, 3);
       s -= nn * nn.dot(s);
+    }
+  }
+
+  // K -> S K S + (I - S) d: the filtered system, whose solution has no
+  // component along a held node's normal (S = I - n n^T on held nodes).
+  void filter(const System &sys, SpMat &K) const {
+    if (!active) return;
+    double *val = K.valuePtr();
+    for (size_t j = 0; j < sys.adj.size(); ++j) {
+      const Eigen::Vector3d nj = normal.row(static_cast<Eigen::Index>(j));
+      const bool hj = nj.squaredNorm() > 0;
+      for (size_t p = 0; p < sys.adj[j].size(); ++p) {
+        const int i = sys.adj[j][p];
+        const Eigen::Vector3d ni = normal.row(i);
+        const bool hi = ni.squaredNorm() > 0;
+        if (!hi && !hj) continue;
+        const Block b{K.outerIndexPtr()[3 * j] + 3 * static_cast<int>(p), 3 * static_cast<int>(sys.adj[j].size())};
+        Eigen::Map<Eigen::Matrix3d, 0, Eigen::OuterStride<>> B(val + b.base, Eigen::OuterStride<>(b.stride));
+        Eigen::Matrix3d M = B;
+        if (hi) M -= ni * (ni.transpose() * M);
+        if (hj) M -= (M * nj) * nj.transpose();
+        if (hi && static_cast<size_t>(i) == j) M += (B.trace() / 3) * ni * ni.transpose();
+        B = M;
+      }
     }
   }
 };
@@ -358,9 +413,12 @@ double max_node_motion(const Vec &dx) {
 
 // Baraff and Witkin's modified PCG: solves A x = b in the subspace the
 // filter leaves free. `apply` computes A p, `precondition` z = P^-1 r.
+// Stops early, setting *indefinite, when A shows a direction of
+// non-positive curvature.
 template <class Apply, class Precondition>
 int filtered_pcg(const Apply &apply, const Precondition &precondition, const Contacts &c, const Vec &b,
-                 Vec &x, int max_iter, double relative) {
+                 Vec &x, int max_iter, double relative, bool *indefinite = nullptr) {
+  if (indefinite) *indefinite = false;
   x.setZero(b.size());
   Vec r = b;
   c.filter(r);
@@ -377,7 +435,10 @@ int filtered_pcg(const Apply &apply, const Precondition &precondition, const Con
     apply(p, q);
     c.filter(q);
     const double pq = p.dot(q);
-    if (!(pq > 0)) break;
+    if (!(pq > 0)) {
+      if (indefinite) *indefinite = true;
+      break;
+    }
     const double alpha = delta / pq;
     x += alpha * p;
     r -= alpha * q;
@@ -392,20 +453,88 @@ int filtered_pcg(const Apply &apply, const Precondition &precondition, const Con
 
 bool finite(const Vec &v) { return v.allFinite(); }
 
-FactorCache::Entry *rest_factor(const System &sys, const std::vector<int> &vertices, FactorCache *cache,
-                                std::unique_ptr<FactorCache::Entry> &own) {
+std::string number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
+}
+
+}  // namespace
+
+// One dynamic set's system, its symbolic factorisation (the fill-reducing
+// ordering), and the rest-state factorisation once needed.
+struct FactorCache::Entry {
+  std::unique_ptr<System> sys;
+  Ldlt symbolic;  // analysed on the pattern; factorised per Newton step
+  std::unique_ptr<Ldlt> rest;
+  bool rest_ok = false;
+  int refresh_after = 0;  // newton: CG iterations worth a refactorisation (0: not known yet)
+};
+
+FactorCache::FactorCache() = default;
+FactorCache::~FactorCache() = default;
+FactorCache::Entry *FactorCache::find(const std::vector<int> &vertices) const {
+  auto it = entries_.find(vertices);
+  return it == entries_.end() ? nullptr : it->second.get();
+}
+FactorCache::Entry *FactorCache::insert(const std::vector<int> &vertices, std::unique_ptr<Entry> e) {
+  Entry *raw = e.get();
+  entries_[vertices] = std::move(e);
+  return raw;
+}
+void FactorCache::clear() { entries_.clear(); }
+
+const char *solver_name(SolverKind kind) {
+  switch (kind) {
+    case SolverKind::Newton: return "newton";
+    case SolverKind::NewtonRest: return "newton-rest";
+    case SolverKind::ImplicitEuler: return "implicit-euler";
+    case SolverKind::NewtonJacobi: return "newton-jacobi";
+  }
+  return "?";
+}
+
+bool solver_from_name(const std::string &name, SolverKind *kind) {
+  for (SolverKind k : kSolverKinds)
+    if (name == solver_name(k)) {
+      *kind = k;
+      return true;
+    }
+  return false;
+}
+
+bool skull_rejects(const SkinModel &m, int v) {
+  if (m.skull_free[static_cast<size_t>(v)]) return false;
+  const Eigen::Vector3d out = m.X0.row(v).transpose() - m.centre;
+  return m.normal.row(v).dot(out) > 0.3 * out.norm();
+}
+
+namespace {
+
+// The cached system of `vertices` (built and analysed on first use).
+FactorCache::Entry *entry_for(const SkinModel &model, const std::vector<int> &vertices, FactorCache *cache,
+                              std::unique_ptr<FactorCache::Entry> &own) {
   if (cache)
-    if (FactorCache::Entry *e = cache->find(vertices)) return e;
+    if (FactorCache::Entry *e = cache->find(vertices); e && &e->sys->m == &model) return e;
   auto e = std::make_unique<FactorCache::Entry>();
-  Linearisation rest;
-  linearise(sys, sys.m.X0, rest);
-  // The volume term's rank-one blocks are left out: springs alone are SPD
-  // and close enough for a preconditioner.
-  e->ldlt.compute(rest.K);
-  e->ok = e->ldlt.info() == Eigen::Success;
+  e->sys = std::make_unique<System>(model, vertices);
+  if (e->sys->dofs() > 0) e->symbolic.analyzePattern(e->sys->pattern);
   if (cache) return cache->insert(vertices, std::move(e));
   own = std::move(e);
   return own.get();
+}
+
+// The rest-state Hessian's factorisation, computed once per entry.
+const Ldlt *rest_factor(FactorCache::Entry &e) {
+  if (!e.rest) {
+    e.rest = std::make_unique<Ldlt>();
+    SpMat K;
+    Vec diag;
+    linearise(*e.sys, e.sys->m.X0, K, diag);
+    e.rest->compute(K);
+    e.rest_ok = e.rest->info() == Eigen::Success;
+  }
+  return e.rest_ok ? e.rest.get() : nullptr;
 }
 
 }  // namespace
@@ -421,9 +550,26 @@ Eigen::MatrixXd residual_forces(const SkinModel &model, const std::vector<int> &
   return out;
 }
 
+Expected<Eigen::MatrixXd> linear_response(const SkinModel &model, const std::vector<int> &vertices,
+                                          const ForceField &load, FactorCache *cache) {
+  std::unique_ptr<FactorCache::Entry> own;
+  FactorCache::Entry *e = entry_for(model, vertices, cache, own);
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(model.X0.rows(), 3);
+  if (e->sys->dofs() == 0) return out;
+  const Ldlt *rest = rest_factor(*e);
+  if (!rest) return Status::error("linear response: the rest-state Hessian is singular");
+  Eigen::MatrixXd F = Eigen::MatrixXd::Zero(model.X0.rows(), 3);
+  load(model.X0, &F);
+  const Vec u = rest->solve(gather_rows(*e->sys, F));
+  if (!finite(u)) return Status::error("linear response: non-finite displacement");
+  for (size_t i = 0; i < e->sys->nodes.size(); ++i)
+    out.row(e->sys->nodes[i]) = u.segment<3>(3 * static_cast<int>(i)).transpose();
+  return out;
+}
+
 SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &vertices,
                              const ForceField &forces, const Eigen::MatrixXd &reference, Eigen::MatrixXd &X,
-                             const SolverOptions &options, FactorCache *cache) {
+                             const SolverOptions &options, FactorCache *cache, LoadControl *control) {
   const auto start = std::chrono::steady_clock::now();
   SolveStats st;
   auto done = [&](bool ok, std::string message) {
@@ -432,58 +578,55 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return st;
   };
+  const std::string name = solver_name(options.kind);
   if (!(options.tolerance > 0)) return done(false, "solver: tolerance must be positive");
-  System sys(model, vertices);
+  if (control && options.kind == SolverKind::ImplicitEuler)
+    return done(false, "solver: implicit-euler cannot solve for a tension (use a newton solver)");
+  if (control && !(control->unit_load && control->action))
+    return done(false, "solver: a load control needs a unit load and an action");
+  std::unique_ptr<FactorCache::Entry> own;
+  FactorCache::Entry *entry = entry_for(model, vertices, cache, own);
+  const System &sys = *entry->sys;
   const int n = sys.dofs();
   st.unknowns = n;
-  if (n == 0) return done(true, "");
+  if (n == 0) return done(!control, control ? "solver: the dynamic set is empty" : "");
 
-  auto gather = [&](const Eigen::MatrixXd &P, Vec &x) {
-    x.resize(n);
-    for (size_t i = 0; i < sys.nodes.size(); ++i) x.segment<3>(3 * static_cast<int>(i)) = P.row(sys.nodes[i]).transpose();
-  };
+  auto gather = [&](const Eigen::MatrixXd &P, Vec &x) { x = gather_rows(sys, P); };
   auto scatter = [&](const Vec &x, Eigen::MatrixXd &P) {
     for (size_t i = 0; i < sys.nodes.size(); ++i) P.row(sys.nodes[i]) = x.segment<3>(3 * static_cast<int>(i)).transpose();
   };
 
   Contacts contacts;
   update_contacts(sys, X, contacts);
-  Linearisation lin;
-  Vec r, dx, x0, trial;
+  SpMat K;
+  Vec diag, r, dx, x0, trial;
   const double tol = options.tolerance;
-
-  std::unique_ptr<FactorCache::Entry> own;
-  FactorCache::Entry *factor = nullptr;
-  if (options.kind == SolverKind::Newton) {
-    factor = rest_factor(sys, vertices, cache, own);
-    if (!factor->ok) return done(false, "solver: the rest-state Hessian of the dynamic set is singular");
-  }
-  auto jacobi = [&](const Vec &diag) {
-    return [&diag](const Vec &in, Vec &out) { out = in.cwiseQuotient(diag.cwiseMax(1e-300)); };
+  auto jacobi = [](const Vec &d) {
+    return [&d](const Vec &in, Vec &out) { out = in.cwiseQuotient(d.cwiseMax(1e-300)); };
   };
 
   if (options.kind == SolverKind::ImplicitEuler) {
     const int max_steps = options.max_iterations > 0 ? options.max_iterations : 2000;
     Vec mass(n);
     for (size_t i = 0; i < sys.nodes.size(); ++i) mass.segment<3>(3 * static_cast<int>(i)).setConstant(model.mass[sys.nodes[i]]);
-    linearise(sys, X, lin);
-    const double t0 = std::sqrt(mass.mean() / std::max(lin.diag.mean(), 1e-300));
+    linearise(sys, X, K, diag);
+    const double t0 = std::sqrt(mass.mean() / std::max(diag.mean(), 1e-300));
     const double h = options.time_step * t0, gamma = options.damping / t0;
     Vec v = Vec::Zero(n), dv, Kv(n), b(n);
     for (int step = 0; step < max_steps; ++step) {
       net_force(sys, forces, reference, X, r);
-      if (step > 0) linearise(sys, X, lin);
-      st.residual = displacement_estimate([&] { Vec f = r; contacts.filter(f); return f; }(), lin.diag);
+      if (step > 0) linearise(sys, X, K, diag);
+      st.residual = displacement_estimate([&] { Vec f = r; contacts.filter(f); return f; }(), diag);
       if (!finite(r)) return done(false, "implicit-euler: non-finite force at step " + std::to_string(step));
       if (step > 0 && st.residual < tol && st.last_step < tol) {
         st.contacts = contacts.active;
         return done(true, "");
       }
-      hessian_times(sys, lin, v, Kv);
+      Kv.noalias() = K * v;
       b = h * (r - gamma * mass.cwiseProduct(v) - h * Kv);
-      const Vec adiag = (1 + h * gamma) * mass + h * h * lin.diag;
+      const Vec adiag = (1 + h * gamma) * mass + h * h * diag;
       auto apply = [&](const Vec &p, Vec &out) {
-        hessian_times(sys, lin, p, out);
+        out.noalias() = K * p;
         out = (1 + h * gamma) * mass.cwiseProduct(p) + h * h * out;
       };
       st.cg_iterations += filtered_pcg(apply, jacobi(adiag), contacts, b, dv, options.max_cg, options.cg_relative);
@@ -499,63 +642,178 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     }
     st.contacts = contacts.active;
     return done(false, "implicit-euler: no equilibrium after " + std::to_string(max_steps) +
-                           " steps (remaining displacement " + std::to_string(st.residual) + ")");
+                           " steps (remaining displacement " + number(st.residual) + ")");
   }
 
-  // Newton (factorised or Jacobi preconditioner).
-  std::unique_ptr<FactorCache::Entry> fresh;
-  const int max_it = options.max_iterations > 0 ? options.max_iterations : 200;
+  // Newton. The step solves K dx = r on the filtered subspace:
+  //   newton         CG preconditioned by a factorisation of the filtered
+  //                  tangent, refactorised whenever CG needed more than
+  //                  kRefresh iterations with the one it has (the first
+  //                  step always factorises);
+  //   newton-rest    CG preconditioned by the rest-state factorisation,
+  //                  shared by every solve on the set, until CG needs more
+  //                  than kRefreshRest iterations; then as newton;
+  //   newton-jacobi  CG with the Jacobi preconditioner.
+  constexpr int kRefresh = 3, kRefreshRest = 30;
+  const Ldlt *rest = nullptr;
+  if (options.kind == SolverKind::NewtonRest) {
+    rest = rest_factor(*entry);
+    if (!rest) return done(false, "solver: the rest-state Hessian of the dynamic set is singular");
+  }
+  const Ldlt *factor = rest;
+  bool refresh = options.kind == SolverKind::Newton;
+  SpMat Kf;  // the filtered tangent, factorised
+  Eigen::MatrixXd unit_f;
+  Vec g, u, w, cgrad;
+  double t = control ? std::max(control->tension, 0.0) : 0.0;
+  // Load control gives up once the tension passes this multiple of its
+  // first estimate (the linear one from rest): the tissue has locked.
+  constexpr double kUnreachable = 50;
+  double t_ref = t;
+  Eigen::MatrixXd Ac;
+  auto load_at = [&](double tension) -> ForceField {
+    if (!control) return forces;
+    return [&, tension](const Eigen::MatrixXd &P, Eigen::MatrixXd *F) {
+      double e = forces ? forces(P, F) : 0.0;
+      if (!F) return e + tension * control->unit_load(P, nullptr);
+      Eigen::MatrixXd G = Eigen::MatrixXd::Zero(P.rows(), 3);
+      e += tension * control->unit_load(P, &G);
+      *F += tension * G;
+      return e;
+    };
+  };
+  auto linear_solve = [&](const Vec &b, Vec &x, bool *indefinite) {
+    auto apply = [&](const Vec &p, Vec &out) { out.noalias() = K * p; };
+    if (factor)
+      return filtered_pcg(apply, [&](const Vec &in, Vec &out) { out = factor->solve(in); }, contacts, b, x,
+                          options.max_cg, options.cg_relative, indefinite);
+    return filtered_pcg(apply, jacobi(diag), contacts, b, x, options.max_cg, options.cg_relative, indefinite);
+  };
+  const int max_it = options.max_iterations > 0 ? options.max_iterations : 400;
+  double action = 0;
   for (int it = 0;; ++it) {
-    net_force(sys, forces, reference, X, r);
-    if (!finite(r)) return done(false, solver_name(options.kind) + std::string(": non-finite force"));
-    linearise(sys, X, lin);
+    const ForceField load = load_at(t);
+    net_force(sys, load, reference, X, r);
+    if (!finite(r)) return done(false, name + ": non-finite force");
+    linearise(sys, X, K, diag, 1.0);
     Vec rf = r;
     contacts.filter(rf);
-    st.residual = displacement_estimate(rf, lin.diag);
-    if (it > 0 && st.residual < tol && st.last_step < tol) break;
+    st.residual = displacement_estimate(rf, diag);
+    if (control) {
+      Ac = Eigen::MatrixXd::Zero(X.rows(), 3);
+      action = control->action(X, &Ac);
+      cgrad = gather_rows(sys, Ac);
+      contacts.filter(cgrad);
+      if (!(cgrad.squaredNorm() > 0)) return done(false, name + ": the controlled action does not depend on the dynamic set");
+    }
+    const bool on_target = !control || std::abs(action - control->value) < tol;
+    if (it > 0 && st.residual < tol && st.last_step < tol && on_target) break;
     if (it >= max_it) {
       st.contacts = contacts.active;
-      return done(false, std::string(solver_name(options.kind)) + ": no equilibrium after " +
-                             std::to_string(max_it) + " iterations (remaining displacement " +
-                             std::to_string(st.residual) + ")");
+      std::string why = name + ": no equilibrium after " + std::to_string(max_it) +
+                        " iterations (remaining displacement " + number(st.residual);
+      if (control) why += ", action " + number(action) + " of " + number(control->value);
+      return done(false, why + ")");
     }
-    auto apply = [&](const Vec &p, Vec &out) { hessian_times(sys, lin, p, out); };
-    if (factor) {
-      // The rest factorisation preconditions while it is close; when the
-      // tangent has drifted (CG needed many iterations), factorise the
-      // current one for the rest of this solve.
-      const Eigen::SimplicialLDLT<SpMat, Eigen::Lower> &ldlt = fresh ? fresh->ldlt : factor->ldlt;
-      const int cg = filtered_pcg(apply, [&](const Vec &in, Vec &out) { out = ldlt.solve(in); }, contacts, rf,
-                                  dx, options.max_cg, options.cg_relative);
-      st.cg_iterations += cg;
-      if (cg > kRefactorAfter) {
-        if (!fresh) fresh = std::make_unique<FactorCache::Entry>();
-        fresh->ldlt.compute(lin.K);
-        if (fresh->ldlt.info() != Eigen::Success) fresh.reset();
+    // The full tangent while it is definite: Newton then converges
+    // quadratically near the equilibrium. Where it is not (compressed
+    // springs, strongly deformed elements), the projected one (linearise()).
+    double curvature = 1;
+    auto project = [&] { linearise(sys, X, K, diag, curvature = 0); };
+    if (refresh) {
+      for (;;) {
+        Kf = K;
+        contacts.filter(sys, Kf);
+        entry->symbolic.factorize(Kf);
+        ++st.factorisations;
+        const bool ok = entry->symbolic.info() == Eigen::Success;
+        if (ok && (curvature == 0 || (entry->symbolic.vectorD().array() > 0).all())) break;
+        if (curvature == 0) return done(false, name + ": the tangent stiffness is singular");
+        project();
+      }
+      factor = &entry->symbolic;
+      // A projected factorisation preconditions the next full tangent
+      // badly (hundreds of CG iterations on Song): try the full one again
+      // at the next step.
+      refresh = curvature == 0 && options.kind == SolverKind::Newton;
+      if (entry->refresh_after == 0) {
+        // A factorisation costs sum_j c_j^2 (c_j: column j of L), a CG
+        // iteration about 4 nnz(L) + nnz(K): refresh once CG spends a third
+        // of a factorisation.
+        const SpMat &L = entry->symbolic.matrixL().nestedExpression();
+        double flops = 0;
+        for (Eigen::Index j = 0; j < L.cols(); ++j) {
+          const double c = L.outerIndexPtr()[j + 1] - L.outerIndexPtr()[j];
+          flops += c * c;
+        }
+        const double ratio = flops / (4.0 * static_cast<double>(L.nonZeros()) + static_cast<double>(K.nonZeros()));
+        entry->refresh_after = std::max(kRefresh, static_cast<int>(ratio / 3));
       }
     }
-    else {
-      st.cg_iterations += filtered_pcg(apply, jacobi(lin.diag), contacts, rf, dx, options.max_cg,
-                                       options.cg_relative);
+    bool indefinite = false;
+    int cg = 0, cg2 = 0;
+    double dt = 0;
+    for (;;) {
+      cg += linear_solve(rf, u, &indefinite);
+      if (control && !indefinite) {
+        unit_f = Eigen::MatrixXd::Zero(X.rows(), 3);
+        control->unit_load(X, &unit_f);
+        g = gather_rows(sys, unit_f);
+        cg2 += linear_solve(g, w, &indefinite);
+      }
+      if (!indefinite || curvature == 0) break;
+      project();  // CG met a direction of negative curvature
     }
-    if (!finite(dx)) return done(false, std::string(solver_name(options.kind)) + ": non-finite step");
+    if (control) {
+      cg = std::max(cg, cg2);
+      // Bordered step: choose dt so that the linearised action of
+      // X + u + dt w meets the target.
+      const double cw = cgrad.dot(w);
+      if (!(std::abs(cw) > 0) || !std::isfinite(cw)) return done(false, name + ": the load does not move the controlled action");
+      double t_new = t + (control->value - action - cgrad.dot(u)) / cw;
+      // Bounded steps: the tissue stiffens, and far from the equilibrium
+      // the linearised action is a rough guide.
+      if (t > 0) t_new = std::clamp(t_new, 0.5 * t, 4 * t);
+      if (!(t_new > 0)) return done(false, name + ": the load moves the controlled action the wrong way");
+      if (!std::isfinite(t_new)) return done(false, name + ": non-finite tension");
+      if (t_ref == 0) t_ref = t_new;
+      if (t_new > kUnreachable * t_ref)
+        return done(false, name + ": the load cannot take the action to " + number(control->value) +
+                               " (it reached " + number(action) + " at " + number(kUnreachable) +
+                               " times the linear estimate of the tension)");
+      dt = t_new - t;
+      t = t_new;
+      dx = u + dt * w;
+    } else {
+      dx = u;
+    }
+    st.cg_iterations += cg;
+    if (options.kind != SolverKind::NewtonJacobi &&
+        cg > (options.kind == SolverKind::NewtonRest ? kRefreshRest : std::max(kRefresh, entry->refresh_after)))
+      refresh = true;
+    if (!finite(dx)) return done(false, name + ": non-finite step");
     // Backtracking (Armijo) on the total energy: the loads are conservative.
+    const ForceField next_load = load_at(t);
+    Vec rn = rf;
+    if (control) rn += dt * [&] { Vec gf = g; contacts.filter(gf); return gf; }();
     gather(X, x0);
-    const double e0 = total_energy(sys, forces, reference, X), slope = rf.dot(dx);
+    const double e0 = total_energy(sys, next_load, reference, X), slope = rn.dot(dx);
     double alpha = 1;
     Eigen::MatrixXd Xt = X;
-    for (int ls = 0; ls < 12; ++ls, alpha *= 0.5) {
+    for (int ls = 0; ls < 12; ++ls) {
       trial = x0 + alpha * dx;
       scatter(trial, Xt);
-      const double e = total_energy(sys, forces, reference, Xt);
-      if (std::isfinite(e) && e <= e0 - 1e-4 * alpha * std::max(slope, 0.0)) break;
+      const double e = total_energy(sys, next_load, reference, Xt);
+      if ((std::isfinite(e) && e <= e0 - 1e-4 * alpha * std::max(slope, 0.0)) || ls == 11) break;
+      alpha *= 0.5;
     }
-    if (!finite(trial)) return done(false, std::string(solver_name(options.kind)) + ": non-finite step");
+    if (!finite(trial)) return done(false, name + ": non-finite step");
     scatter(trial, X);
     st.last_step = alpha * max_node_motion(dx);
     st.last_step = std::max(st.last_step, update_contacts(sys, X, contacts));
     st.iterations = it + 1;
   }
+  if (control) control->tension = t;
   st.contacts = contacts.active;
   return done(true, "");
 }

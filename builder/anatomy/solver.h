@@ -5,18 +5,26 @@
 // dynamic vertices, 3 coordinates each. Everything else (static vertices,
 // every skull node) stays where X has it. Forces (docs/anatomy.md):
 //   springs   biphasic, SkinModel::stiffness(); tangent stiffness
-//             T'(l) u u^T + max(T, 0) / l (I - u u^T) (compressed springs'
-//             negative geometric term dropped, so the Hessian stays SPD);
+//             T'(l) u u^T + T / l (I - u u^T);
 //   volume    per element, Lee, Terzopoulos and Waters' two terms in
 //             energy form (docs/anatomy.md): E_v = k_v (V - V0)^2 / (2 |V0|),
-//             force -k_v (V - V0) / |V0| dV/dp, Hessian taken as the
-//             Gauss-Newton k_v / |V0| dV/dp dV/dp^T; and the shape term
-//             E_s = k_s |V0| / A / 2 sum_i |d_i - mean(d)|^2 over the
-//             element's 12 nodes, d = X - reference (their k2 term: each
-//             node held at its rest place relative to the element's centre),
-//             with the constant Hessian k_s |V0| / A (delta_ij - 1/12) I.
-//             `reference` is the unloaded shape: the rest state, or the
-//             rest state carried by the jaw for a jaw pose;
+//             force -k_v (V - V0) / |V0| dV/dp, Hessian
+//             k_v / |V0| (dV/dp dV/dp^T + (V - V0) d2V/dp2); and the shape
+//             term E_s = k_s |V0| / R^2 / 2 sum_i |d_i - mean(d)|^2 over the
+//             element's 12 nodes, d = X - reference, R^2 the element's
+//             squared radius of gyration at rest (their k2 term: each node
+//             held at its rest place relative to the element's centre;
+//             divided by R^2, a strain energy independent of the mesh
+//             resolution), with the constant Hessian
+//             k_s |V0| / R^2 (delta_ij - 1/12) I. `reference` is the
+//             unloaded shape: the rest state, or the rest state carried by
+//             the jaw for a jaw pose;
+//             The tangent above is the full one. Its "projected" form drops
+//             the compressed springs' negative T / l and the volume's
+//             second-order part, and is positive semi-definite everywhere.
+//             The solvers use the full tangent where it is definite and the
+//             projected one where it is not (implicit-euler: always the
+//             projected one);
 //   muscles   the ForceField, a conservative load (its Hessian is left out);
 //   skull     non-penetration as a constraint: a node below the plane of
 //             its skull node (normal: the vertex's rest normal) is put back
@@ -27,17 +35,33 @@
 //             faces the centre of gravity (lip curls, nostrils) are never
 //             constrained.
 //
-// Solvers:
-//   newton          Newton's method on the static equations; CG on the
-//                   sparse Hessian preconditioned by one Cholesky (LDLT)
-//                   factorisation of the rest-state Hessian of the dynamic
-//                   set, kept in a FactorCache and shared by every solve on
-//                   that set. The default.
+// Solvers (bench_builder compares them; docs/anatomy.md has the figures):
+//   newton          Newton's method on the static equations. The step solves
+//                   the (constraint-filtered) tangent system with CG
+//                   preconditioned by a Cholesky (LDLT) factorisation of the
+//                   filtered tangent itself, so CG takes one or two
+//                   iterations; the factorisation is reused while CG stays
+//                   cheap and refreshed once a linear solve spends over a
+//                   third of a factorisation's cost in CG iterations (counted
+//                   from the pattern: deterministic). The fill-reducing
+//                   ordering is computed once per dynamic set (FactorCache).
+//                   The default: fastest in bench_builder.
+//   newton-rest     the same, preconditioned by one factorisation of the
+//                   rest-state Hessian of the set, shared by every solve on
+//                   it (FactorCache), until CG needs more than 30 iterations.
 //   implicit-euler  the paper's scheme: Baraff-Witkin implicit Euler steps
 //                   (M (1 + h gamma) + h^2 K) dv = h (f - h K v), the modified
 //                   (constraint-filtered) CG with a Jacobi preconditioner, run
 //                   until the motion stops.
 //   newton-jacobi   Newton with a Jacobi-preconditioned CG: no factorisation.
+//
+// Load control (calibration, section 3.3): with a LoadControl the load is
+// `forces` + t x `unit_load`, and t is an unknown too, fixed by one more
+// equation: action(X) = value. Each Newton step is the bordered one: with
+// u = K^-1 r and w = K^-1 g (g the unit load), t moves by dt such that the
+// linearised action of X + u + dt w meets the value, and the step is
+// u + dt w (t grows at most fourfold per step, since the tissue stiffens).
+// The newton solvers only.
 //
 // Stopping rule, the same for all three, with tol = SolverOptions::tolerance
 // (afm-build passes half the AFM position quantum, so the result is exact to
@@ -61,14 +85,17 @@
 
 namespace afmb {
 
-enum class SolverKind { Newton, ImplicitEuler, NewtonJacobi };
-const char *solver_name(SolverKind kind);  // "newton", "implicit-euler", "newton-jacobi"
+enum class SolverKind { Newton, NewtonRest, ImplicitEuler, NewtonJacobi };
+constexpr SolverKind kSolverKinds[] = {SolverKind::Newton, SolverKind::NewtonRest, SolverKind::ImplicitEuler,
+                                       SolverKind::NewtonJacobi};
+// "newton", "newton-rest", "implicit-euler", "newton-jacobi"
+const char *solver_name(SolverKind kind);
 bool solver_from_name(const std::string &name, SolverKind *kind);
 
 struct SolverOptions {
   SolverKind kind = SolverKind::Newton;
   double tolerance = 0;       // model units, > 0 (see the stopping rule)
-  int max_iterations = 0;     // Newton iterations or time steps; 0: 200 (Newton), 2000 (Euler)
+  int max_iterations = 0;     // Newton iterations or time steps; 0: 400 (Newton), 2000 (Euler)
   int max_cg = 4000;          // CG iterations per linear solve
   double cg_relative = 1e-5;  // CG stops when the preconditioned residual fell by this
   // implicit-euler: step and mass-proportional damping in units of the
@@ -81,6 +108,7 @@ struct SolveStats {
   bool converged = false;
   int iterations = 0;     // Newton iterations or time steps
   int cg_iterations = 0;  // summed over every linear solve
+  int factorisations = 0; // numeric factorisations of the tangent (newton)
   int unknowns = 0;       // 3 x free nodes
   int contacts = 0;       // nodes held on the skull at the end
   double residual = 0;    // the Jacobi displacement estimate at the end, model units
@@ -95,8 +123,10 @@ struct SolveStats {
 // energy, springs + volume + this potential.
 using ForceField = std::function<double(const Eigen::MatrixXd &X, Eigen::MatrixXd *F)>;
 
-// Factorisations of rest-state Hessians, one per dynamic set, reused by every
-// solve on the same set. Not thread-safe: one cache per thread.
+// Per dynamic set (and skin model): the unknowns, the Hessian's sparsity
+// pattern, its fill-reducing ordering, and the rest-state factorisation once
+// a solver needed it; reused by every solve on the same set. Not
+// thread-safe: one cache per thread.
 class FactorCache {
  public:
   FactorCache();
@@ -111,14 +141,31 @@ class FactorCache {
   std::map<std::vector<int>, std::unique_ptr<Entry>> entries_;
 };
 
-// Solves for equilibrium on `vertices`, the shape term measured from `reference` (4n x 3) (sorted, unique skin vertex indices;
-// vertices in no triangle are ignored), starting from X (4n x 3; also holds
-// every fixed node) and writing the result into X. `cache` may be null for
-// the Jacobi-preconditioned solvers; newton without a cache factorises for
-// this call only.
+// Solving for a tension as well (calibration): see "Load control" above.
+struct LoadControl {
+  ForceField unit_load;  // the load at tension 1
+  // The controlled quantity at X (model units), adding its gradient (4n x 3)
+  // to `gradient` when given.
+  std::function<double(const Eigen::MatrixXd &X, Eigen::MatrixXd *gradient)> action;
+  double value = 0;    // the action wanted
+  double tension = 0;  // in: the start (0: from rest); out: the tension found (> 0)
+};
+
+// Solves for equilibrium on `vertices` (sorted, unique skin vertex indices;
+// vertices in no triangle are ignored), the shape term measured from
+// `reference` (4n x 3), starting from X (4n x 3; also holds every fixed
+// node) and writing the result into X. `cache` may be null (everything is
+// then built for this call only). With `control`, the tension is solved for
+// too and written back to control->tension on success.
 SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &vertices,
                              const ForceField &forces, const Eigen::MatrixXd &reference, Eigen::MatrixXd &X,
-                             const SolverOptions &options, FactorCache *cache);
+                             const SolverOptions &options, FactorCache *cache, LoadControl *control = nullptr);
+
+// The rest state's linear displacement under `load` (4n x 3, zero outside
+// `vertices`): K0^-1 f, no skull contacts. Cheap once the set's rest
+// factorisation is cached; used to estimate how far a muscle's wave reaches.
+Expected<Eigen::MatrixXd> linear_response(const SkinModel &model, const std::vector<int> &vertices,
+                                          const ForceField &load, FactorCache *cache);
 
 // The residual force (4n x 3, zero on fixed nodes) of positions X: springs,
 // volume and `forces`, for checks and tests.

@@ -28,8 +28,11 @@ void usage(FILE *out) {
       "  --orient SPEC|auto      map the input axes to the MPEG-4 frame (see afm-import)\n"
       "  --fdp-format F          auto (default), xfaceed, text or visage\n"
       "  --flip-v                texture v runs down in this model (as afm-import)\n"
-      "  --solver S              newton (default), implicit-euler (the paper's scheme) or\n"
-      "                          newton-jacobi\n"
+      "  --solver S              newton (default), newton-rest, implicit-euler (the\n"
+      "                          paper's scheme) or newton-jacobi (solver.h; calibration\n"
+      "                          always runs a newton solver)\n"
+      "  --threads N             calibration workers (default: one per core; the model\n"
+      "                          is the same for any N)\n"
       "  --no-estimates          do not estimate missing FDPs from the reference head:\n"
       "                          muscles lacking FDPs are skipped (or, if essential, the\n"
       "                          build fails)\n"
@@ -98,7 +101,13 @@ int main(int argc, char **argv) {
     } else if (a == "--solver") {
       const std::string s = value("--solver");
       if (!solver_from_name(s, &fo.solver.kind))
-        return usage_error("--solver '" + s + "': use newton, implicit-euler or newton-jacobi");
+        return usage_error("--solver '" + s + "': use newton, newton-rest, implicit-euler or newton-jacobi");
+    } else if (a == "--threads") {
+      const std::string t = value("--threads");
+      char *end = nullptr;
+      const long n = std::strtol(t.c_str(), &end, 10);
+      if (t.empty() || *end || n < 1 || n > 256) return usage_error("--threads '" + t + "': use a count, 1..256");
+      fo.threads = static_cast<int>(n);
     } else if (a == "--no-estimates") {
       fo.estimate_missing_fdps = false;
     } else if (a == "--no-calibrate") {
