@@ -53,8 +53,13 @@ Expected<Jaw> build_jaw(const SkinModel &skin, const FdpSet &fdps, const Fapu &f
   for (int v : jaw.ray_hits)
     if (!std::binary_search(upper.begin(), upper.end(), v)) set.push_back(v);
   jaw.removed = static_cast<int>(jaw.ray_hits.size() - set.size());
+  // The lower lip the rays miss; the window reaches below the chin, whose
+  // underside is not lip: nothing below the chin's lowest point (2.1).
+  std::vector<int> lip;
+  for (int v : lower)
+    if (skin.X0(v, 1) >= P("2.1").y()) lip.push_back(v);
   std::vector<int> merged;
-  std::set_union(set.begin(), set.end(), lower.begin(), lower.end(), std::back_inserter(merged));
+  std::set_union(set.begin(), set.end(), lip.begin(), lip.end(), std::back_inserter(merged));
   jaw.added = static_cast<int>(merged.size() - set.size());
   jaw.vertices = std::move(merged);
   if (jaw.vertices.empty()) return Status::error("jaw: no skin vertex maps to the jaw");

@@ -18,6 +18,18 @@ double tet_volume(const Eigen::Vector3d &p0, const Eigen::Vector3d &p1, const Ei
   return (p1 - p0).dot((p2 - p0).cross(p3 - p0)) / 6.0;
 }
 
+// The six corners of slab `slab` of element f: nodes (3 below the other 3)
+// and their rows in element_volume()'s gradient (-1 for the skull's corners,
+// which are never solved for).
+void slab_corners(const SkinModel &m, int f, int slab, int node[6], int row[6]) {
+  for (int k = 0; k < 3; ++k) {
+    node[k] = m.node(slab, m.F(f, k));
+    node[3 + k] = m.node(slab + 1, m.F(f, k));
+    row[k] = slab * 3 + k;
+    row[3 + k] = slab < 2 ? (slab + 1) * 3 + k : -1;
+  }
+}
+
 }  // namespace
 
 double SkinModel::stiffness(const Spring &s) const {
@@ -125,11 +137,8 @@ Expected<SkinModel> build_skin_model(const Scene &scene, int part, const TissueP
   const double cs = params.crossed_share;
   for (int f = 0; f < m.F.rows(); ++f) {
     for (int slab = 0; slab < 3; ++slab) {
-      int node[6];
-      for (int k = 0; k < 3; ++k) {
-        node[k] = m.node(slab, m.F(f, k));
-        node[3 + k] = m.node(slab + 1, m.F(f, k));
-      }
+      int node[6], row[6];
+      slab_corners(m, f, slab, node, row);
       double vp = 0;
       for (const auto &t : kTets)
         vp += tet_volume(m.X0.row(node[t[0]]), m.X0.row(node[t[1]]), m.X0.row(node[t[2]]),
@@ -188,12 +197,7 @@ double element_volume(const SkinModel &m, const Eigen::MatrixXd &X, int f,
   double v = 0;
   for (int slab = 0; slab < 3; ++slab) {
     int node[6], row[6];
-    for (int k = 0; k < 3; ++k) {
-      node[k] = m.node(slab, m.F(f, k));
-      node[3 + k] = m.node(slab + 1, m.F(f, k));
-      row[k] = slab * 3 + k;
-      row[3 + k] = slab < 2 ? (slab + 1) * 3 + k : -1;  // skull corners: no gradient row
-    }
+    slab_corners(m, f, slab, node, row);
     for (const auto &t : kTets) {
       const Eigen::Vector3d p0 = X.row(node[t[0]]), p1 = X.row(node[t[1]]), p2 = X.row(node[t[2]]),
                             p3 = X.row(node[t[3]]);
@@ -220,12 +224,7 @@ void element_volume_hessian(const SkinModel &m, const Eigen::MatrixXd &X, int f,
   };
   for (int slab = 0; slab < 3; ++slab) {
     int node[6], row[6];
-    for (int k = 0; k < 3; ++k) {
-      node[k] = m.node(slab, m.F(f, k));
-      node[3 + k] = m.node(slab + 1, m.F(f, k));
-      row[k] = slab * 3 + k;
-      row[3 + k] = slab < 2 ? (slab + 1) * 3 + k : -1;
-    }
+    slab_corners(m, f, slab, node, row);
     for (const auto &t : kTets) {
       // V = a . (b x c) / 6 with a, b, c = p1 - p0, p2 - p0, p3 - p0: its
       // second derivatives in (a, b, c) are skew blocks, zero on the diagonal.
@@ -256,11 +255,8 @@ void element_volume_hessian(const SkinModel &m, const Eigen::MatrixXd &X, int f,
 
 void element_tet_volumes(const SkinModel &m, const Eigen::MatrixXd &X, int f, double out[9]) {
   for (int slab = 0; slab < 3; ++slab) {
-    int node[6];
-    for (int k = 0; k < 3; ++k) {
-      node[k] = m.node(slab, m.F(f, k));
-      node[3 + k] = m.node(slab + 1, m.F(f, k));
-    }
+    int node[6], row[6];
+    slab_corners(m, f, slab, node, row);
     for (int t = 0; t < 3; ++t)
       out[slab * 3 + t] = tet_volume(X.row(node[kTets[t][0]]), X.row(node[kTets[t][1]]),
                                      X.row(node[kTets[t][2]]), X.row(node[kTets[t][3]]));

@@ -682,12 +682,12 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
       return e;
     };
   };
-  auto linear_solve = [&](const Vec &b, Vec &x, bool *indefinite) {
+  auto linear_solve = [&](const Vec &b, Vec &x, bool *indefinite, int max_cg) {
     auto apply = [&](const Vec &p, Vec &out) { out.noalias() = K * p; };
     if (factor)
       return filtered_pcg(apply, [&](const Vec &in, Vec &out) { out = factor->solve(in); }, contacts, b, x,
-                          options.max_cg, options.cg_relative, indefinite);
-    return filtered_pcg(apply, jacobi(diag), contacts, b, x, options.max_cg, options.cg_relative, indefinite);
+                          max_cg, options.cg_relative, indefinite);
+    return filtered_pcg(apply, jacobi(diag), contacts, b, x, max_cg, options.cg_relative, indefinite);
   };
   const int max_it = options.max_iterations > 0 ? options.max_iterations : 400;
   double action = 0;
@@ -720,7 +720,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     // springs, strongly deformed elements), the projected one (linearise()).
     double curvature = 1;
     auto project = [&] { linearise(sys, X, K, diag, curvature = 0); };
-    if (refresh) {
+    auto factorise = [&] {
       for (;;) {
         Kf = K;
         contacts.filter(sys, Kf);
@@ -728,14 +728,10 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
         ++st.factorisations;
         const bool ok = entry->symbolic.info() == Eigen::Success;
         if (ok && (curvature == 0 || (entry->symbolic.vectorD().array() > 0).all())) break;
-        if (curvature == 0) return done(false, name + ": the tangent stiffness is singular");
+        if (curvature == 0) return false;
         project();
       }
       factor = &entry->symbolic;
-      // A projected factorisation preconditions the next full tangent
-      // badly (hundreds of CG iterations on Song): try the full one again
-      // at the next step.
-      refresh = curvature == 0 && options.kind == SolverKind::Newton;
       if (entry->refresh_after == 0) {
         // A factorisation costs sum_j c_j^2 (c_j: column j of L), a CG
         // iteration about 4 nnz(L) + nnz(K): refresh once CG spends a third
@@ -749,17 +745,31 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
         const double ratio = flops / (4.0 * static_cast<double>(L.nonZeros()) + static_cast<double>(K.nonZeros()));
         entry->refresh_after = std::max(kRefresh, static_cast<int>(ratio / 3));
       }
-    }
+      return true;
+    };
+    bool fresh = refresh;
+    if (refresh && !factorise()) return done(false, name + ": the tangent stiffness is singular");
+    refresh = false;
+    // newton: CG past a factorisation's worth of iterations (a stale
+    // factorisation, say a projected one before a full tangent) stops, and
+    // the step starts over with a fresh factorisation.
+    const int cap = options.kind == SolverKind::Newton ? 3 * std::max(kRefresh, entry->refresh_after) : options.max_cg;
     bool indefinite = false;
     int cg = 0, cg2 = 0;
     double dt = 0;
     for (;;) {
-      cg += linear_solve(rf, u, &indefinite);
+      int c1 = linear_solve(rf, u, &indefinite, cap), c2 = 0;
       if (control && !indefinite) {
         unit_f = Eigen::MatrixXd::Zero(X.rows(), 3);
         control->unit_load(X, &unit_f);
         g = gather_rows(sys, unit_f);
-        cg2 += linear_solve(g, w, &indefinite);
+        c2 = linear_solve(g, w, &indefinite, cap);
+      }
+      cg += c1, cg2 += c2;
+      if (!fresh && !indefinite && std::max(c1, c2) >= cap) {
+        if (!factorise()) return done(false, name + ": the tangent stiffness is singular");
+        fresh = true;
+        continue;
       }
       if (!indefinite || curvature == 0) break;
       project();  // CG met a direction of negative curvature

@@ -43,7 +43,9 @@
 //                   iterations; the factorisation is reused while CG stays
 //                   cheap and refreshed once a linear solve spends over a
 //                   third of a factorisation's cost in CG iterations (counted
-//                   from the pattern: deterministic). The fill-reducing
+//                   from the pattern: deterministic); a CG run past a whole
+//                   factorisation's worth stops and the step starts over
+//                   with a fresh one. The fill-reducing
 //                   ordering is computed once per dynamic set (FactorCache).
 //                   The default: fastest in bench_builder.
 //   newton-rest     the same, preconditioned by one factorisation of the

@@ -5,6 +5,7 @@
 // the FDPs anatomy says the muscle moves.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 
@@ -332,6 +333,14 @@ TEST(Physics, TheJawOpens) {
   EXPECT_LT(moved(m, p->X, "9.3").norm(), 0.1e-3) << "the nose stays";
   EXPECT_TRUE(p->X.allFinite());
   EXPECT_EQ(penetrating_nodes(m.tissue, p->X, 1e-9), 0);
+  // The mouth-window search adds the lower lip, not the chin's underside.
+  EXPECT_GT(m.jaw.added, 0);
+  const double chin_bottom = m.fdps.find(*FdpId::parse("2.1"))->pos.y();
+  for (int v : m.jaw.vertices) {
+    if (!std::binary_search(m.jaw.ray_hits.begin(), m.jaw.ray_hits.end(), v)) {
+      EXPECT_GE(m.tissue.X0(v, 1), chin_bottom) << "vertex " << v << " added below the chin";
+    }
+  }
 }
 
 TEST(Physics, ResidualBelowToleranceAtTheEnd) {
