@@ -647,9 +647,10 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
 
   // Newton. The step solves K dx = r on the filtered subspace:
   //   newton         CG preconditioned by a factorisation of the filtered
-  //                  tangent, refactorised whenever CG needed more than
-  //                  kRefresh iterations with the one it has (the first
-  //                  step always factorises);
+  //                  tangent (the first step always factorises), refreshed
+  //                  for the next step once CG needed more than
+  //                  Entry::refresh_after iterations (at least kRefresh), and
+  //                  at once when a CG run reaches three times that;
   //   newton-rest    CG preconditioned by the rest-state factorisation,
   //                  shared by every solve on the set, until CG needs more
   //                  than kRefreshRest iterations; then as newton;
