@@ -767,7 +767,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
         c2 = linear_solve(g, w, &indefinite, cap);
       }
       cg += c1, cg2 += c2;
-      if (!fresh && !indefinite && std::max(c1, c2) >= cap) {
+      if (options.kind == SolverKind::Newton && !fresh && !indefinite && std::max(c1, c2) >= cap) {
         if (!factorise()) return done(false, name + ": the tangent stiffness is singular");
         fresh = true;
         continue;
