@@ -99,7 +99,7 @@ struct SolverOptions {
   double tolerance = 0;       // model units, > 0 (see the stopping rule)
   int max_iterations = 0;     // Newton iterations or time steps; 0: 400 (Newton), 2000 (Euler)
   int max_cg = 4000;          // CG iterations per linear solve
-  double cg_relative = 1e-3;  // CG stops when the preconditioned residual fell by this
+  double cg_relative = 1e-5;  // CG stops when the preconditioned residual fell by this
   // implicit-euler: step and mass-proportional damping in units of the
   // system's own time t0 = sqrt(mean mass / mean stiffness diagonal).
   double time_step = 20.0;
