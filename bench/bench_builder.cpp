@@ -37,7 +37,7 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
     std::printf("build failed: %s\n", m.status().message().c_str());
     return false;
   }
-  std::printf("model (%d skin vertices, %zu muscles and the jaw calibrated): %.2f s\n", m->tissue.n,
+  std::printf("model (%d skin vertices, %zu muscles and the jaw calibrated, a worker per core): %.2f s\n", m->tissue.n,
               m->muscles.size(), now() - t0);
   for (const std::string &w : m->warnings) std::printf("warning: %s\n", w.c_str());
 

@@ -284,19 +284,16 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
 
   // In table order: a muscle that cannot reach its range is skipped, as one
   // lacking FDPs; an essential one fails the build.
-  for (size_t k = todo.size(); k-- > 0;) {
-    if (result[k]) continue;
-    const Muscle &m = model.muscles[todo[k]];
-    if (muscle_table()[static_cast<size_t>(m.def)].essential) return result[k].wrap("essential muscle");
-  }
+  std::vector<const Status *> failed(model.muscles.size(), nullptr);
+  for (size_t k = 0; k < todo.size(); ++k)
+    if (!result[k]) failed[todo[k]] = &result[k];
+  for (size_t i = 0; i < model.muscles.size(); ++i)
+    if (failed[i] && table[static_cast<size_t>(model.muscles[i].def)].essential)
+      return failed[i]->wrap("essential muscle");
   std::vector<Muscle> kept;
-  for (size_t i = 0, k = 0; i < model.muscles.size(); ++i) {
-    const bool calibrated = k < todo.size() && todo[k] == i;
-    if (calibrated && !result[k++]) {
-      model.warnings.push_back(result[k - 1].message() + ": skipped");
-      continue;
-    }
-    kept.push_back(std::move(model.muscles[i]));
+  for (size_t i = 0; i < model.muscles.size(); ++i) {
+    if (failed[i]) model.warnings.push_back(failed[i]->message() + ": skipped");
+    else kept.push_back(std::move(model.muscles[i]));
   }
   model.muscles = std::move(kept);
   if (!options.calibrate_jaw) return model;

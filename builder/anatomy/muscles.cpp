@@ -22,6 +22,23 @@ Status missing(const MuscleDef &d, const std::vector<FdpId> &ids) {
   return Status::error(std::string("muscle ") + d.name + " needs FDP" + (ids.size() > 1 ? "s " : " ") + list);
 }
 
+// A dead load: force c w_i u_i on each influence node, u_i its direction at
+// rest (`direction` of the rest position; zero: no force); potential
+// -c sum_i w_i (p_i - p0_i) . u_i.
+template <class Direction>
+double dead_load(const SkinModel &skin, const Muscle &m, double c, const Direction &direction,
+                 const Eigen::MatrixXd &X, Eigen::MatrixXd *F) {
+  double energy = 0;
+  for (size_t i = 0; i < m.influence.size(); ++i) {
+    const int node = skin.node(m.force_layer, m.influence[i]);
+    const Eigen::Vector3d x0 = skin.X0.row(node);
+    const Eigen::Vector3d u = direction(x0);
+    energy -= c * m.weight[i] * (X.row(node).transpose() - x0).dot(u);
+    if (F) F->row(node) += (c * m.weight[i]) * u.transpose();
+  }
+  return energy;
+}
+
 }  // namespace
 
 Expected<Muscle> place_muscle(const SkinModel &skin, const FdpSet &fdps, int def) {
@@ -178,26 +195,16 @@ double muscle_load(const SkinModel &skin, const Muscle &m, double tension, const
     // Directions at rest: a pull toward a moving point is stable, a push
     // away from one (mentalis, negative contractions) is not, transversally.
     const Eigen::Vector3d a = skin.X0.row(m.node_a);
-    for (size_t i = 0; i < m.influence.size(); ++i) {
-      const int node = skin.node(m.force_layer, m.influence[i]);
-      const Eigen::Vector3d x0 = skin.X0.row(node);
-      const Eigen::Vector3d u = (a - x0).normalized();
-      energy -= s * m.weight[i] * (X.row(node).transpose() - x0).dot(u);
-      if (F) F->row(node) += (s * m.weight[i]) * u.transpose();
-    }
+    energy = dead_load(skin, m, s, [&](const Eigen::Vector3d &x0) { return Eigen::Vector3d((a - x0).normalized()); },
+                       X, F);
   } else if (s < 0) {
     // Widening: a dead load outward along the rest direction from the
     // epicentre. A push away from the moving epicentre direction would be
     // unstable around it (negative stiffness across the radius).
-    for (size_t i = 0; i < m.influence.size(); ++i) {
-      const int node = skin.node(m.force_layer, m.influence[i]);
-      const Eigen::Vector3d x0 = skin.X0.row(node);
+    energy = dead_load(skin, m, -s, [&](const Eigen::Vector3d &x0) {
       const Eigen::Vector3d d0(x0.x() - m.epicentre.x(), x0.y() - m.epicentre.y(), 0.0);
-      if (!(d0.norm() > 0)) continue;
-      const Eigen::Vector3d u = d0.normalized();
-      energy -= -s * m.weight[i] * (X.row(node).transpose() - x0).dot(u);
-      if (F) F->row(node) += (-s * m.weight[i]) * u.transpose();
-    }
+      return d0.norm() > 0 ? Eigen::Vector3d(d0.normalized()) : Eigen::Vector3d::Zero().eval();
+    }, X, F);
   } else {
     const double floor = m.semi_b / 3;
     for (size_t i = 0; i < m.influence.size(); ++i) {

@@ -32,7 +32,7 @@ struct Element {
   int local[9];   // local node per gradient row (layers 0-2), -1 when fixed
   int global[12]; // the element's nodes, layers 0-3
   double weight;  // volume term: k_v / |V0|, 0 for an element seen edge-on
-  double shape;   // shape term: k_s |V0| / area
+  double shape;   // shape term: k_s |V0| / R^2 (R: radius of gyration at rest)
 };
 
 // The unknowns of one dynamic set and the fixed sparsity of their Hessian:
@@ -207,13 +207,13 @@ void add_block(double *values, Block b, const M &B) {
 }
 
 // The Hessian at X into K (the system's pattern): springs, the shape term and
-// the volume term. `diag` gets its diagonal. `projected`: the indefinite
-// parts are dropped (a compressed spring's negative transverse stiffness,
-// the volume's own curvature k_v (V - V0) / |V0| d2V/dp2, leaving its
-// Gauss-Newton part), which keeps K positive semi-definite everywhere; kept,
-// Newton converges quadratically near an equilibrium, where K is definite
-// anyway.
-void linearise(const System &sys, const Eigen::MatrixXd &X, SpMat &K, Vec &diag, double curvature = 0) {
+// the volume term. `diag` gets its diagonal. Not `full` (the projected
+// tangent): the indefinite parts are dropped (a compressed spring's negative
+// transverse stiffness, the volume's own curvature k_v (V - V0) / |V0|
+// d2V/dp2, leaving its Gauss-Newton part), which keeps K positive
+// semi-definite everywhere; `full`, Newton converges quadratically near an
+// equilibrium, where K is definite anyway.
+void linearise(const System &sys, const Eigen::MatrixXd &X, SpMat &K, Vec &diag, bool full = false) {
   const SkinModel &m = sys.m;
   if (K.nonZeros() != sys.pattern.nonZeros()) K = sys.pattern;
   double *val = K.valuePtr();
@@ -225,7 +225,7 @@ void linearise(const System &sys, const Eigen::MatrixXd &X, SpMat &K, Vec &diag,
     const Eigen::Vector3d u = d / l;
     double t, dt;
     tension(s, m.stiffness(s), l, &t, &dt);
-    const double geo = (t >= 0 ? t : curvature * t) / l;
+    const double geo = (t >= 0 || full ? t : 0.0) / l;
     const Eigen::Matrix3d B = (dt - geo) * u * u.transpose() + geo * Eigen::Matrix3d::Identity();
     const std::array<Block, 4> &bl = sys.spring_blocks[q];
     if (bl[0].base >= 0) add_block(val, bl[0], B);
@@ -238,7 +238,8 @@ void linearise(const System &sys, const Eigen::MatrixXd &X, SpMat &K, Vec &diag,
     const Element &el = sys.elements[e];
     double excess = 0;  // k_v (V - V0) / |V0|: the weight of the volume's own curvature
     if (el.weight > 0) {
-      excess = curvature * el.weight * (element_volume(m, X, el.f, &g) - m.rest_volume[el.f]);
+      const double v = element_volume(m, X, el.f, &g);
+      if (full) excess = el.weight * (v - m.rest_volume[el.f]);
       if (excess != 0) element_volume_hessian(m, X, el.f, &H);
     }
     for (int i = 0; i < 9; ++i)
@@ -256,6 +257,18 @@ void linearise(const System &sys, const Eigen::MatrixXd &X, SpMat &K, Vec &diag,
     const Block b = sys.diagonal[i];
     for (int r = 0; r < 3; ++r) diag[3 * static_cast<Eigen::Index>(i) + r] = val[b.base + r * b.stride + r];
   }
+}
+
+// The rows of a 4n x 3 field at the free nodes, as a dofs vector.
+Vec gather_rows(const System &sys, const Eigen::MatrixXd &F) {
+  Vec v(sys.dofs());
+  for (size_t i = 0; i < sys.nodes.size(); ++i) v.segment<3>(3 * static_cast<int>(i)) = F.row(sys.nodes[i]).transpose();
+  return v;
+}
+
+// The inverse: a dofs vector into the free nodes' rows of P (4n x 3).
+void scatter_rows(const System &sys, const Vec &x, Eigen::MatrixXd &P) {
+  for (size_t i = 0; i < sys.nodes.size(); ++i) P.row(sys.nodes[i]) = x.segment<3>(3 * static_cast<int>(i)).transpose();
 }
 
 // Internal plus external force on the free nodes.
@@ -294,15 +307,8 @@ void net_force(const System &sys, const ForceField &forces, const Eigen::MatrixX
   if (forces) {
     Eigen::MatrixXd F = Eigen::MatrixXd::Zero(X.rows(), 3);
     forces(X, &F);
-    for (size_t i = 0; i < sys.nodes.size(); ++i) r.segment<3>(3 * static_cast<int>(i)) += F.row(sys.nodes[i]).transpose();
+    r += gather_rows(sys, F);
   }
-}
-
-// The rows of a 4n x 3 field at the free nodes, as a dofs vector.
-Vec gather_rows(const System &sys, const Eigen::MatrixXd &F) {
-  Vec v(sys.dofs());
-  for (size_t i = 0; i < sys.nodes.size(); ++i) v.segment<3>(3 * static_cast<int>(i)) = F.row(sys.nodes[i]).transpose();
-  return v;
 }
 
 // Total potential energy of the system: springs, volume, external load.
@@ -546,7 +552,7 @@ Eigen::MatrixXd residual_forces(const SkinModel &model, const std::vector<int> &
   Vec r;
   net_force(sys, forces, reference, X, r);
   Eigen::MatrixXd out = Eigen::MatrixXd::Zero(X.rows(), 3);
-  for (size_t i = 0; i < sys.nodes.size(); ++i) out.row(sys.nodes[i]) = r.segment<3>(3 * static_cast<int>(i)).transpose();
+  scatter_rows(sys, r, out);
   return out;
 }
 
@@ -562,8 +568,7 @@ Expected<Eigen::MatrixXd> linear_response(const SkinModel &model, const std::vec
   load(model.X0, &F);
   const Vec u = rest->solve(gather_rows(*e->sys, F));
   if (!finite(u)) return Status::error("linear response: non-finite displacement");
-  for (size_t i = 0; i < e->sys->nodes.size(); ++i)
-    out.row(e->sys->nodes[i]) = u.segment<3>(3 * static_cast<int>(i)).transpose();
+  scatter_rows(*e->sys, u, out);
   return out;
 }
 
@@ -590,11 +595,6 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
   const int n = sys.dofs();
   st.unknowns = n;
   if (n == 0) return done(!control, control ? "solver: the dynamic set is empty" : "");
-
-  auto gather = [&](const Eigen::MatrixXd &P, Vec &x) { x = gather_rows(sys, P); };
-  auto scatter = [&](const Vec &x, Eigen::MatrixXd &P) {
-    for (size_t i = 0; i < sys.nodes.size(); ++i) P.row(sys.nodes[i]) = x.segment<3>(3 * static_cast<int>(i)).transpose();
-  };
 
   Contacts contacts;
   update_contacts(sys, X, contacts);
@@ -633,9 +633,9 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
       if (!finite(dv)) return done(false, "implicit-euler: non-finite velocity at step " + std::to_string(step));
       v += dv;
       contacts.filter(v);
-      gather(X, x0);
+      x0 = gather_rows(sys, X);
       x0 += h * v;
-      scatter(x0, X);
+      scatter_rows(sys, x0, X);
       st.last_step = h * max_node_motion(v);
       update_contacts(sys, X, contacts);
       st.iterations = step + 1;
@@ -696,7 +696,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     const ForceField load = load_at(t);
     net_force(sys, load, reference, X, r);
     if (!finite(r)) return done(false, name + ": non-finite force");
-    linearise(sys, X, K, diag, 1.0);
+    linearise(sys, X, K, diag, true);
     Vec rf = r;
     contacts.filter(rf);
     st.residual = displacement_estimate(rf, diag);
@@ -719,8 +719,8 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     // The full tangent while it is definite: Newton then converges
     // quadratically near the equilibrium. Where it is not (compressed
     // springs, strongly deformed elements), the projected one (linearise()).
-    double curvature = 1;
-    auto project = [&] { linearise(sys, X, K, diag, curvature = 0); };
+    bool full = true;
+    auto project = [&] { linearise(sys, X, K, diag, full = false); };
     auto factorise = [&] {
       for (;;) {
         Kf = K;
@@ -728,8 +728,8 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
         entry->symbolic.factorize(Kf);
         ++st.factorisations;
         const bool ok = entry->symbolic.info() == Eigen::Success;
-        if (ok && (curvature == 0 || (entry->symbolic.vectorD().array() > 0).all())) break;
-        if (curvature == 0) return false;
+        if (ok && (!full || (entry->symbolic.vectorD().array() > 0).all())) break;
+        if (!full) return false;
         project();
       }
       factor = &entry->symbolic;
@@ -772,7 +772,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
         fresh = true;
         continue;
       }
-      if (!indefinite || curvature == 0) break;
+      if (!indefinite || !full) break;
       project();  // CG met a direction of negative curvature
     }
     if (control) {
@@ -807,19 +807,19 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     const ForceField next_load = load_at(t);
     Vec rn = rf;
     if (control) rn += dt * [&] { Vec gf = g; contacts.filter(gf); return gf; }();
-    gather(X, x0);
+    x0 = gather_rows(sys, X);
     const double e0 = total_energy(sys, next_load, reference, X), slope = rn.dot(dx);
     double alpha = 1;
     Eigen::MatrixXd Xt = X;
     for (int ls = 0; ls < 12; ++ls) {
       trial = x0 + alpha * dx;
-      scatter(trial, Xt);
+      scatter_rows(sys, trial, Xt);
       const double e = total_energy(sys, next_load, reference, Xt);
       if ((std::isfinite(e) && e <= e0 - 1e-4 * alpha * std::max(slope, 0.0)) || ls == 11) break;
       alpha *= 0.5;
     }
     if (!finite(trial)) return done(false, name + ": non-finite step");
-    scatter(trial, X);
+    scatter_rows(sys, trial, X);
     st.last_step = alpha * max_node_motion(dx);
     st.last_step = std::max(st.last_step, update_contacts(sys, X, contacts));
     st.iterations = it + 1;

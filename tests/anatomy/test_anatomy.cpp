@@ -42,6 +42,13 @@ const Built &head_1k() {
   return *b;
 }
 
+// The set without FDP `id`.
+FdpSet without(FdpSet f, const std::string &id) {
+  f.points.erase(std::remove_if(f.points.begin(), f.points.end(), [&](const FdpPoint &p) { return p.id.str() == id; }),
+                 f.points.end());
+  return f;
+}
+
 std::vector<int> all_vertices(const SkinModel &s) {
   std::vector<int> v;
   for (int i = 0; i < s.n; ++i)
@@ -513,10 +520,7 @@ TEST(BadInput, NotAFaceFlippedOrMissingFdps) {
   // Missing FDPs without estimates: frontalis skipped naming 11.1, an
   // essential muscle fails the build.
   {
-    FdpSet f = b.head.fdps;
-    f.points.erase(std::remove_if(f.points.begin(), f.points.end(),
-                                  [](const FdpPoint &p) { return p.id.str() == "11.1"; }),
-                   f.points.end());
+    const FdpSet f = without(b.head.fdps, "11.1");
     FaceModelOptions fo;
     fo.calibrate = false;
     fo.estimate_missing_fdps = false;
@@ -533,10 +537,7 @@ TEST(BadInput, NotAFaceFlippedOrMissingFdps) {
     EXPECT_NE(m->notes[0].find("FDP 11.1 absent"), std::string::npos);
   }
   {
-    FdpSet f = b.head.fdps;
-    f.points.erase(std::remove_if(f.points.begin(), f.points.end(),
-                                  [](const FdpPoint &p) { return p.id.str() == "5.3"; }),
-                   f.points.end());
+    const FdpSet f = without(b.head.fdps, "5.3");
     FaceModelOptions fo;
     fo.calibrate = false;
     fo.estimate_missing_fdps = false;
@@ -555,11 +556,8 @@ TEST(FdpCompletion, EstimatesLandNearTheTrueFdps) {
   ASSERT_TRUE(h.is_ok());
   const double es0 = 0.063;
   for (const char *id : {"3.7", "11.1", "2.13", "9.15"}) {
-    FdpSet f = h->fdps;
-    const Eigen::Vector3d truth = f.find(*FdpId::parse(id))->pos;
-    f.points.erase(std::remove_if(f.points.begin(), f.points.end(),
-                                  [&](const FdpPoint &p) { return p.id.str() == id; }),
-                   f.points.end());
+    const Eigen::Vector3d truth = h->fdps.find(*FdpId::parse(id))->pos;
+    FdpSet f = without(h->fdps, id);
     std::vector<std::string> notes;
     Expected<std::vector<FdpId>> added = complete_fdps(h->scene, h->scene.find_kind(PartKind::Skin), f,
                                                         {*FdpId::parse(id)}, &notes);
