@@ -94,8 +94,8 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
     SolveStats st[2];
     for (int s = 0; s < 2; ++s) {
       const FaceModel &fm = s == 0 ? *m : *ms;
-      ForceField f = [&](const Eigen::MatrixXd &X, Eigen::MatrixXd *F) {
-        return muscle_load(fm.tissue, zm, zm.tension_max, X, F);
+      ForceField f = [&](const Eigen::MatrixXd &X, Eigen::MatrixXd *F, NodeBlocks *K) {
+        return muscle_load(fm.tissue, zm, zm.tension_max, X, F, K);
       };
       Eigen::MatrixXd X = fm.tissue.X0;
       SolverOptions so = m->solver;

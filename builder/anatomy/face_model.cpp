@@ -93,11 +93,11 @@ Status solve_growing(const FaceModel &model, std::vector<int> &set, const ForceF
 }
 
 ForceField activation_forces(const FaceModel &model, const std::vector<std::pair<int, double>> &muscles) {
-  return [&model, muscles](const Eigen::MatrixXd &X, Eigen::MatrixXd *F) {
+  return [&model, muscles](const Eigen::MatrixXd &X, Eigen::MatrixXd *F, NodeBlocks *K) {
     double energy = 0;
     for (const auto &[i, pct] : muscles) {
       const Muscle &m = model.muscles[static_cast<size_t>(i)];
-      energy += muscle_load(model.tissue, m, muscle_tension(m, pct), X, F);
+      energy += muscle_load(model.tissue, m, muscle_tension(m, pct), X, F, K);
     }
     return energy;
   };
@@ -105,8 +105,8 @@ ForceField activation_forces(const FaceModel &model, const std::vector<std::pair
 
 // The muscle's load at unit tension, pulling (+1) or pushing (-1).
 ForceField unit_load(const FaceModel &model, const Muscle &m, double sign) {
-  return [&model, &m, sign](const Eigen::MatrixXd &X, Eigen::MatrixXd *F) {
-    return muscle_load(model.tissue, m, sign, X, F);
+  return [&model, &m, sign](const Eigen::MatrixXd &X, Eigen::MatrixXd *F, NodeBlocks *K) {
+    return muscle_load(model.tissue, m, sign, X, F, K);
   };
 }
 

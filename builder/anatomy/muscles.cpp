@@ -187,7 +187,7 @@ void remove_from_influence(Muscle &m, const std::vector<int> &vertices) {
 }
 
 double muscle_load(const SkinModel &skin, const Muscle &m, double tension, const Eigen::MatrixXd &X,
-                   Eigen::MatrixXd *F) {
+                   Eigen::MatrixXd *F, NodeBlocks *K) {
   if (tension == 0) return 0.0;
   const double s = m.sense * tension;
   double energy = 0;
@@ -213,6 +213,19 @@ double muscle_load(const SkinModel &skin, const Muscle &m, double tension, const
       const double r = d.norm();
       energy += s * m.weight[i] * (r >= floor ? r : r * r / (2 * floor) + floor / 2);
       if (F) F->row(node) -= (s * m.weight[i] / std::max(r, floor)) * d.transpose();
+      if (K) {
+        // Hessian of s w h(r) in x-y: s w (I - u u^T) / r beyond the floor
+        // (the pull turns with the node), s w I / floor within it.
+        Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
+        H(0, 0) = H(1, 1) = 1;
+        if (r >= floor) {
+          const Eigen::Vector3d u = d / r;
+          H = (H - u * u.transpose()) / r;
+        } else {
+          H /= floor;
+        }
+        K->emplace_back(node, (s * m.weight[i]) * H);
+      }
     }
   }
   return energy;

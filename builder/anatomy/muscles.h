@@ -33,6 +33,7 @@
 
 #include "anatomy/muscle_table.h"
 #include "anatomy/skin_model.h"
+#include "anatomy/solver.h"
 #include "core/fdp.h"
 #include "core/fapu.h"
 
@@ -94,7 +95,9 @@ Expected<MouthLips> mouth_lips(const SkinModel &skin, const FdpSet &fdps);
 void remove_from_influence(Muscle &m, const std::vector<int> &vertices);
 
 // The muscle's load at signed tension t and positions X: returns its
-// potential energy and, when F is given, adds its forces (4n x 3). The field
+// potential energy; when F is given, adds its forces (4n x 3); when K is
+// given, appends its Hessian (a ForceField's, solver.h: the contracting
+// sphincter's only, the others are dead loads). The field
 // is conservative: a linear muscle's pull is a dead load along the rest
 // direction u0 from the node to A, potential -t sense w (p - p0) . u0 (a
 // push away from a moving point would be unstable across the fibre); a
@@ -103,7 +106,7 @@ void remove_from_influence(Muscle &m, const std::vector<int> &vertices);
 // r^2 / (2 floor) + floor / 2 within it; widening, a dead load outward
 // along the rest offset, for the same reason as the linear push.
 double muscle_load(const SkinModel &skin, const Muscle &m, double tension, const Eigen::MatrixXd &X,
-                   Eigen::MatrixXd *F);
+                   Eigen::MatrixXd *F, NodeBlocks *K = nullptr);
 
 // How far the muscle has acted at positions X (model units, positive in the
 // direction of its action): linear, the insertion's motion along the fibre

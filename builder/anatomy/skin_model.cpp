@@ -175,7 +175,13 @@ Expected<SkinModel> build_skin_model(const Scene &scene, int part, const TissueP
     nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
   }
   m.rest_volume.resize(m.F.rows());
-  for (int f = 0; f < m.F.rows(); ++f) m.rest_volume[f] = element_volume(m, m.X0, f);
+  m.nominal_volume.resize(m.F.rows());
+  for (int f = 0; f < m.F.rows(); ++f) {
+    m.rest_volume[f] = element_volume(m, m.X0, f);
+    const Eigen::Vector3d a = m.X0.row(m.F(f, 0)), b = m.X0.row(m.F(f, 1)), d = m.X0.row(m.F(f, 2));
+    m.nominal_volume[f] = 0.5 * (b - a).cross(d - a).norm() *
+                          (m.thickness[m.F(f, 0)] + m.thickness[m.F(f, 1)] + m.thickness[m.F(f, 2)]) / 3.0;
+  }
   m.skull_free.assign(static_cast<size_t>(n), 0);
   return m;
 }

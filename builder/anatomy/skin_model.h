@@ -92,6 +92,11 @@ struct SkinModel {
   Eigen::MatrixXd normal;  // n x 3: epidermal vertex normals at rest (area-weighted, unit)
   Eigen::VectorXd thickness;  // n: epidermis to skull distance
   Eigen::VectorXd rest_volume;  // #F: signed volume of each element (all three slabs)
+  // #F: the volume the element would have if its tissue lay straight under
+  // its skin: triangle area x mean thickness of its corners (> 0). Where the
+  // line to the centre grazes the skin (lip curls, nostrils) the prism is
+  // seen edge-on and |rest_volume| is a small part of it.
+  Eigen::VectorXd nominal_volume;
   std::vector<std::vector<int>> neighbours;    // n: vertex adjacency of the skin mesh
   std::vector<std::vector<int>> vertex_faces;  // n: triangles at each vertex
   // Per vertex: 1 = not tied to the bone (lips, cheeks): its springs from

@@ -32,7 +32,7 @@ struct Element {
   int local[9];   // local node per gradient row (layers 0-2), -1 when fixed
   int global[12]; // the element's nodes, layers 0-3
   double weight;  // volume term: k_v / |V0|, 0 for an element seen edge-on
-  double shape;   // shape term: k_s |V0| / R^2 (R: radius of gyration at rest)
+  double shape;   // shape term: k_s V_nom / R^2 (R: radius of gyration at rest)
 };
 
 // The unknowns of one dynamic set and the fixed sparsity of their Hessian:
@@ -98,11 +98,14 @@ struct System {
         e.weight = v0 < kVolumeFloor * mean ? 0.0 : m.params.volume_modulus / v0;
         // Divided by the element's squared radius of gyration at rest, the
         // shape energy is modulus x volume x (relative displacement / size)^2:
-        // a strain energy, the same at every mesh resolution.
+        // a strain energy, the same at every mesh resolution. The nominal
+        // volume, not |V0|: a prism seen edge-on from the centre (lip curls)
+        // has almost no volume but still holds tissue; without its shape
+        // term it shears flat and flips.
         Eigen::Matrix<double, 12, 3> p;
         for (int k = 0; k < 12; ++k) p.row(k) = m.X0.row(e.global[k]);
         const double gyration2 = (p.rowwise() - p.colwise().mean()).squaredNorm() / 12.0;
-        e.shape = gyration2 > 0 ? m.params.shape_modulus * v0 / gyration2 : 0.0;
+        e.shape = gyration2 > 0 ? m.params.shape_modulus * m.nominal_volume[f] / gyration2 : 0.0;
         elements.push_back(e);
       }
     }
@@ -259,6 +262,19 @@ void linearise(const System &sys, const Eigen::MatrixXd &X, SpMat &K, Vec &diag,
   }
 }
 
+// Adds the load's Hessian (ForceField) at X to K and diag.
+void add_load_stiffness(const System &sys, const ForceField &load, const Eigen::MatrixXd &X, SpMat &K, Vec &diag) {
+  if (!load) return;
+  NodeBlocks blocks;
+  load(X, nullptr, &blocks);
+  for (const auto &[node, B] : blocks) {
+    const int l = node >= 0 && node < static_cast<int>(sys.local.size()) ? sys.local[static_cast<size_t>(node)] : -1;
+    if (l < 0) continue;
+    add_block(K.valuePtr(), sys.diagonal[static_cast<size_t>(l)], B);
+    for (int q = 0; q < 3; ++q) diag[3 * l + q] += B(q, q);
+  }
+}
+
 // The rows of a 4n x 3 field at the free nodes, as a dofs vector.
 Vec gather_rows(const System &sys, const Eigen::MatrixXd &F) {
   Vec v(sys.dofs());
@@ -306,7 +322,7 @@ void net_force(const System &sys, const ForceField &forces, const Eigen::MatrixX
   }
   if (forces) {
     Eigen::MatrixXd F = Eigen::MatrixXd::Zero(X.rows(), 3);
-    forces(X, &F);
+    forces(X, &F, nullptr);
     r += gather_rows(sys, F);
   }
 }
@@ -331,7 +347,7 @@ double total_energy(const System &sys, const ForceField &forces, const Eigen::Ma
       e += 0.5 * el.shape * (d.rowwise() - d.colwise().mean()).squaredNorm();
     }
   }
-  if (forces) e += forces(X, nullptr);
+  if (forces) e += forces(X, nullptr, nullptr);
   return e;
 }
 
@@ -565,7 +581,7 @@ Expected<Eigen::MatrixXd> linear_response(const SkinModel &model, const std::vec
   const Ldlt *rest = rest_factor(*e);
   if (!rest) return Status::error("linear response: the rest-state Hessian is singular");
   Eigen::MatrixXd F = Eigen::MatrixXd::Zero(model.X0.rows(), 3);
-  load(model.X0, &F);
+  load(model.X0, &F, nullptr);  // the tissue's own stiffness: the wave's reach
   const Vec u = rest->solve(gather_rows(*e->sys, F));
   if (!finite(u)) return Status::error("linear response: non-finite displacement");
   scatter_rows(*e->sys, u, out);
@@ -612,10 +628,14 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     linearise(sys, X, K, diag);
     const double t0 = std::sqrt(mass.mean() / std::max(diag.mean(), 1e-300));
     const double h = options.time_step * t0, gamma = options.damping / t0;
+    add_load_stiffness(sys, forces, X, K, diag);
     Vec v = Vec::Zero(n), dv, Kv(n), b(n);
     for (int step = 0; step < max_steps; ++step) {
       net_force(sys, forces, reference, X, r);
-      if (step > 0) linearise(sys, X, K, diag);
+      if (step > 0) {
+        linearise(sys, X, K, diag);
+        add_load_stiffness(sys, forces, X, K, diag);
+      }
       st.residual = displacement_estimate([&] { Vec f = r; contacts.filter(f); return f; }(), diag);
       if (!finite(r)) return done(false, "implicit-euler: non-finite force at step " + std::to_string(step));
       if (step > 0 && st.residual < tol && st.last_step < tol) {
@@ -674,12 +694,18 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
   Eigen::MatrixXd Ac;
   auto load_at = [&](double tension) -> ForceField {
     if (!control) return forces;
-    return [&, tension](const Eigen::MatrixXd &P, Eigen::MatrixXd *F) {
-      double e = forces ? forces(P, F) : 0.0;
-      if (!F) return e + tension * control->unit_load(P, nullptr);
-      Eigen::MatrixXd G = Eigen::MatrixXd::Zero(P.rows(), 3);
-      e += tension * control->unit_load(P, &G);
-      *F += tension * G;
+    return [&, tension](const Eigen::MatrixXd &P, Eigen::MatrixXd *F, NodeBlocks *Kl) {
+      double e = forces ? forces(P, F, Kl) : 0.0;
+      NodeBlocks unit;
+      if (!F) {
+        e += tension * control->unit_load(P, nullptr, Kl ? &unit : nullptr);
+      } else {
+        Eigen::MatrixXd G = Eigen::MatrixXd::Zero(P.rows(), 3);
+        e += tension * control->unit_load(P, &G, Kl ? &unit : nullptr);
+        *F += tension * G;
+      }
+      if (Kl)
+        for (const auto &[node, B] : unit) Kl->emplace_back(node, tension * B);
       return e;
     };
   };
@@ -697,6 +723,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     net_force(sys, load, reference, X, r);
     if (!finite(r)) return done(false, name + ": non-finite force");
     linearise(sys, X, K, diag, true);
+    add_load_stiffness(sys, load, X, K, diag);
     Vec rf = r;
     contacts.filter(rf);
     st.residual = displacement_estimate(rf, diag);
@@ -720,7 +747,10 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     // quadratically near the equilibrium. Where it is not (compressed
     // springs, strongly deformed elements), the projected one (linearise()).
     bool full = true;
-    auto project = [&] { linearise(sys, X, K, diag, full = false); };
+    auto project = [&] {
+      linearise(sys, X, K, diag, full = false);
+      add_load_stiffness(sys, load, X, K, diag);
+    };
     auto factorise = [&] {
       for (;;) {
         Kf = K;
@@ -762,7 +792,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
       int c1 = linear_solve(rf, u, &indefinite, cap), c2 = 0;
       if (control && !indefinite) {
         unit_f = Eigen::MatrixXd::Zero(X.rows(), 3);
-        control->unit_load(X, &unit_f);
+        control->unit_load(X, &unit_f, nullptr);
         g = gather_rows(sys, unit_f);
         c2 = linear_solve(g, w, &indefinite, cap);
       }

@@ -25,7 +25,7 @@
 //             The solvers use the full tangent where it is definite and the
 //             projected one where it is not (implicit-euler: always the
 //             projected one);
-//   muscles   the ForceField, a conservative load (its Hessian is left out);
+//   muscles   the ForceField, a conservative load, with its Hessian;
 //   skull     non-penetration as a constraint: a node below the plane of
 //             its skull node (normal: the vertex's rest normal) is put back
 //             on it and may only slide along it (the constraint filter of
@@ -119,11 +119,19 @@ struct SolveStats {
   std::string message;    // why it failed; empty when converged
 };
 
-// A conservative external load: returns its potential energy at positions X
-// and, when F is given, adds its forces (4n x 3, model force units; only the
-// rows of free nodes are read). Newton's line search minimises the total
-// energy, springs + volume + this potential.
-using ForceField = std::function<double(const Eigen::MatrixXd &X, Eigen::MatrixXd *F)>;
+// The Hessian of a load's potential, as 3 x 3 blocks on single nodes
+// (global node index, block): the loads here act node by node.
+using NodeBlocks = std::vector<std::pair<int, Eigen::Matrix3d>>;
+
+// A conservative external load: returns its potential energy at positions X;
+// when F is given, adds its forces (4n x 3, model force units; only the rows
+// of free nodes are read); when K is given, appends the Hessian of its
+// potential (nothing for a dead load; must be positive semi-definite, since
+// the projected tangent takes it as it is). Newton's line search minimises
+// the total energy, springs + volume + this potential. Leaving out a load
+// whose direction turns with the nodes stalls Newton: a sphincter pulling
+// lips toward its epicentre did, 400 iterations at a thirty-second of a step.
+using ForceField = std::function<double(const Eigen::MatrixXd &X, Eigen::MatrixXd *F, NodeBlocks *K)>;
 
 // Per dynamic set (and skin model): the unknowns, the Hessian's sparsity
 // pattern, its fill-reducing ordering, and the rest-state factorisation once
