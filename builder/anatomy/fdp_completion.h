@@ -4,9 +4,11 @@
 // eye corners 3.7-3.14, no jaw corners 2.11-2.14, no 9.4-9.7, 9.15, 8.9,
 // 8.10). The muscles and the jaw need some of these. Each missing one is
 // taken from the reference head (builder/refhead, which has all 84): an
-// affine map is fitted by least squares from the reference head's FDPs to
-// the face's FDPs they share, the missing FDP's reference position is mapped
-// through it, and the result is snapped to the nearest skin vertex.
+// affine map is fitted by weighted least squares from the reference head's
+// FDPs to the face's FDPs they share, each weighted by a Gaussian of its
+// distance from the missing FDP (30 mm on the reference head) plus a small
+// constant (the global fit underneath); the missing FDP's reference position
+// is mapped through it, and the result is snapped to the nearest skin vertex.
 // The estimate is as good as the face resembles an adult human head up to an
 // affine map; tests/anatomy measures it by deleting FDPs that are present.
 #pragma once
@@ -26,7 +28,8 @@ std::vector<FdpId> anatomy_fdps();
 // Adds an estimate for each FDP of `wanted` that `fdps` lacks, as a point on
 // skin part `skin` (vertex and position set, line 0). Appends one line per
 // estimate to `notes` ("FDP 3.7 absent: estimated from the reference head
-// (affine fit to 41 FDPs, rms 2.1 mm): skin vertex 1180"). Fails when fewer
+// (local affine fit to 41 FDPs, rms 2.1): skin vertex 1180"; the rms is the
+// weighted residual of the fit, in model units). Fails when fewer
 // than 8 FDPs are shared with the reference head. Returns the ids added.
 Expected<std::vector<FdpId>> complete_fdps(const Scene &scene, int skin, FdpSet &fdps,
                                            const std::vector<FdpId> &wanted,
