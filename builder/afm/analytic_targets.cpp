@@ -1,5 +1,6 @@
 #include "afm/analytic_targets.h"
 
+#include "afm/rigid_parts.h"
 #include "core/fapu.h"
 #include "refhead/refhead.h"
 
@@ -55,17 +56,6 @@ struct EdgeGraph {
   }
 };
 
-double fapu_of(const Fapu &f, afm_fapu unit) {
-  switch (unit) {
-    case AFM_FAPU_IRISD: return f.irisd0;
-    case AFM_FAPU_ES: return f.es0;
-    case AFM_FAPU_ENS: return f.ens0;
-    case AFM_FAPU_MNS: return f.mns0;
-    case AFM_FAPU_MW: return f.mw0;
-    default: return 0;
-  }
-}
-
 // Reference value and bump radius (in FAPU distances) per FAP.
 struct Shape {
   int reference;
@@ -85,10 +75,6 @@ Shape shape_for(int fap, const Fapu &f) {
   if (fap >= 61 && fap <= 64) return {128, 0.3 * f.es0};
   if (fap >= 65 && fap <= 68) return {256, 0.3 * f.es0};
   return {0, 0};
-}
-
-Eigen::Vector3d direction_of(const afm_fap_info *info) {
-  return Eigen::Vector3d(info->direction[0], info->direction[1], info->direction[2]);
 }
 
 // Rotation about the x axis through `pivot` by `angle` radians, applied to p.
@@ -119,10 +105,10 @@ Expected<AnalyticModel> make_analytic_model(const Scene &scene, const FdpSet &fd
     Shape sh = shape_for(fap, fapu);
     const FdpPoint *p = fdp_on(info->fdp_group, info->fdp_index, skin);
     if (!sh.reference || !p || p->part != skin || p->vertex < 0) continue;
-    const double amplitude = sh.reference * fapu_of(fapu, info->unit) / 1024.0;
+    const double amplitude = sh.reference * fapu_distance(fapu, info->unit) / 1024.0;
     std::vector<double> d = graph.distances(p->vertex, sh.radius);
     Eigen::MatrixXd D = Eigen::MatrixXd::Zero(sk.V.rows(), 3);
-    const Eigen::RowVector3d dir = direction_of(info).transpose();
+    const Eigen::RowVector3d dir = fap_direction(info).transpose();
     const int eye = fap >= 19 && fap <= 22
                         ? scene.find_kind(fap % 2 ? PartKind::EyeLeft : PartKind::EyeRight)
                         : -1;
@@ -238,7 +224,7 @@ Expected<AnalyticModel> make_analytic_model(const Scene &scene, const FdpSet &fd
         double s = d[static_cast<size_t>(v)] / r;
         // At value -256 the FDP moves 256 ENS units down: the target holds
         // the displacement at its (negative) reference value.
-        if (s < 1) D.row(v) = -amplitude * (1 - s * s) * (1 - s * s) * direction_of(info).transpose();
+        if (s < 1) D.row(v) = -amplitude * (1 - s * s) * (1 - s * s) * fap_direction(info).transpose();
       }
       MorphTarget t;
       t.kind = AFM_TARGET_FAP;
@@ -297,44 +283,7 @@ Expected<AnalyticModel> make_analytic_model(const Scene &scene, const FdpSet &fd
   for (int v = 1; v <= 14; ++v) mixed(AFM_TARGET_VISEME, v, visemes[v]);
   for (int e = 1; e <= 6; ++e) mixed(AFM_TARGET_EXPRESSION, e, expressions[e]);
 
-  // Eyeballs turn about their centres; FAP directions give axes and signs.
-  for (auto [kind, part_kind, yaw, pitch, thrust] :
-       {std::tuple{AFM_RIGID_EYE_LEFT, PartKind::EyeLeft, 23, 25, 27},
-        std::tuple{AFM_RIGID_EYE_RIGHT, PartKind::EyeRight, 24, 26, 28}}) {
-    int part = scene.find_kind(part_kind);
-    if (part < 0) continue;
-    RigidPart eye;
-    eye.kind = kind;
-    eye.pivot = scene.parts[static_cast<size_t>(part)].V.colwise().mean().transpose();
-    eye.parts.push_back(part);
-    for (int fap : {yaw, pitch, thrust}) {
-      const afm_fap_info *info = afm_fap(fap);
-      Eigen::Vector3d a = direction_of(info);
-      int axis = a.x() != 0 ? 0 : a.y() != 0 ? 1 : 2;
-      double sign = a[axis];
-      if (info->motion == AFM_MOTION_ROTATE)
-        eye.controls.push_back({fap, static_cast<afm_dof>(AFM_DOF_ROTATE_X + axis), sign});
-      else
-        eye.controls.push_back({fap, static_cast<afm_dof>(AFM_DOF_TRANSLATE_X + axis),
-                                sign * fapu_of(fapu, info->unit) / 1024.0});
-    }
-    model.rigids.push_back(eye);
-  }
-
-  // The head turns about the top of the spine (7.1), moving every part.
-  RigidPart head;
-  head.kind = AFM_RIGID_HEAD;
-  if (const FdpPoint *spine = fdp_pos(7, 1))
-    head.pivot = spine->pos;
-  else
-    head.pivot = sk.V.colwise().mean().transpose() - Eigen::Vector3d(0, 0.5 * fapu.es0, 0);
-  for (size_t p = 0; p < scene.parts.size(); ++p) head.parts.push_back(static_cast<int>(p));
-  for (int fap : {48, 49, 50}) {
-    Eigen::Vector3d a = direction_of(afm_fap(fap));
-    int axis = a.x() != 0 ? 0 : a.y() != 0 ? 1 : 2;
-    head.controls.push_back({fap, static_cast<afm_dof>(AFM_DOF_ROTATE_X + axis), a[axis]});
-  }
-  model.rigids.push_back(head);
+  for (RigidPart &r : eye_and_head_rigids(scene, fdps, fapu, skin)) model.rigids.push_back(std::move(r));
   return model;
 }
 

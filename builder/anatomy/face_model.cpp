@@ -302,13 +302,11 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
   return model;
 }
 
-Expected<Pose> solve_pose(const FaceModel &model, const Activation &a, FactorCache *cache,
-                          const PoseOptions &options) {
-  const SkinModel &skin = model.tissue;
-  Pose pose;
-  pose.X = skin.X0;
-  std::vector<int> set;
-  for (const auto &[i, pct] : a.muscles) {
+namespace {
+
+// Checks the contractions and gathers the union of the muscles' dynamic sets.
+Status muscle_set(const FaceModel &model, const std::vector<std::pair<int, double>> &muscles, std::vector<int> &set) {
+  for (const auto &[i, pct] : muscles) {
     if (i < 0 || i >= static_cast<int>(model.muscles.size()))
       return Status::error("pose: muscle index " + std::to_string(i) + " out of range");
     if (pct < -100 || pct > 100 || !std::isfinite(pct))
@@ -322,6 +320,38 @@ Expected<Pose> solve_pose(const FaceModel &model, const Activation &a, FactorCac
     std::set_union(set.begin(), set.end(), own.begin(), own.end(), std::back_inserter(u));
     set = std::move(u);
   }
+  return Status::ok();
+}
+
+}  // namespace
+
+Expected<Pose> solve_pose_to(const FaceModel &model, const std::vector<std::pair<int, double>> &pattern,
+                             const PoseAction &action, double value, FactorCache *cache, double *scale) {
+  Pose pose;
+  pose.X = model.tissue.X0;
+  std::vector<int> set;
+  if (Status s = muscle_set(model, pattern, set); !s) return s;
+  if (set.empty()) return Status::error("pose: no muscle to scale");
+  LoadControl control;
+  control.unit_load = activation_forces(model, pattern);
+  control.action = action;
+  control.value = value;
+  FactorCache local;
+  Status s = solve_growing(model, set, nullptr, model.tissue.X0, pose.X, model.solver, model.wave_threshold,
+                           cache ? cache : &local, false, &pose.stats, &pose.rounds, &control);
+  if (!s) return s.wrap("pose");
+  if (scale) *scale = control.tension;
+  pose.dynamic = std::move(set);
+  return pose;
+}
+
+Expected<Pose> solve_pose(const FaceModel &model, const Activation &a, FactorCache *cache,
+                          const PoseOptions &options) {
+  const SkinModel &skin = model.tissue;
+  Pose pose;
+  pose.X = skin.X0;
+  std::vector<int> set;
+  if (Status s = muscle_set(model, a.muscles, set); !s) return s;
   const bool jaw_moves = a.jaw_open != 0 || a.jaw_thrust != 0 || a.jaw_shift != 0;
   if (jaw_moves) {
     if (a.jaw_open < 0) return Status::error("pose: the jaw does not open by a negative amount");

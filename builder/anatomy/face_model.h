@@ -112,6 +112,18 @@ struct Pose {
 Expected<Pose> solve_pose(const FaceModel &model, const Activation &activation, FactorCache *cache,
                           const PoseOptions &options = {});
 
+// A quantity of a pose to steer (model units), adding its gradient (4n x 3)
+// to `gradient` when given; it must grow with the load.
+using PoseAction = std::function<double(const Eigen::MatrixXd &X, Eigen::MatrixXd *gradient)>;
+
+// The pose in which `action` reaches `value`: the muscles of `pattern`
+// (percent, -100..100 each) scaled together by one factor s > 0, found with
+// the pose (solver.h, load control). s above 1 extrapolates the calibrated
+// tensions linearly. *scale gets s. Fails as solve_pose does, and when the
+// group cannot take the action to `value` (the message says how far it got).
+Expected<Pose> solve_pose_to(const FaceModel &model, const std::vector<std::pair<int, double>> &pattern,
+                             const PoseAction &action, double value, FactorCache *cache, double *scale);
+
 // The epidermis of a pose, #V x 3 (the skin part's vertex positions).
 Eigen::MatrixXd pose_epidermis(const FaceModel &model, const Pose &pose);
 

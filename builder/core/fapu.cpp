@@ -134,4 +134,19 @@ Expected<Fapu> compute_fapu(const FdpSet &bound, std::string *notes) {
   return f;
 }
 
+double fapu_distance(const Fapu &f, afm_fapu unit) {
+  switch (unit) {
+    case AFM_FAPU_IRISD: return f.irisd0;
+    case AFM_FAPU_ES: return f.es0;
+    case AFM_FAPU_ENS: return f.ens0;
+    case AFM_FAPU_MNS: return f.mns0;
+    case AFM_FAPU_MW: return f.mw0;
+    default: return 0;
+  }
+}
+
+Eigen::Vector3d fap_direction(const afm_fap_info *info) {
+  return Eigen::Vector3d(info->direction[0], info->direction[1], info->direction[2]);
+}
+
 }  // namespace afmb

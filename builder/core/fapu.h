@@ -17,6 +17,9 @@
 // Song and Candide-3 heads, see formats/fdp.md).
 #pragma once
 
+#include <afm/mpeg4.h>
+
+#include <Eigen/Core>
 #include <string>
 
 #include "core/fdp.h"
@@ -33,5 +36,13 @@ namespace afmb {
 // `notes` is given, one line per fallback used is appended to it
 // ("ENS0, MNS0: 9.15 absent, nose base height from 9.3 and 8.1").
 Expected<Fapu> compute_fapu(const FdpSet &bound, std::string *notes = nullptr);
+
+// The distance X0 of a FAP unit, model units (one FAP unit is X0 / 1024);
+// 0 for AFM_FAPU_AU and AFM_FAPU_NONE.
+double fapu_distance(const Fapu &fapu, afm_fapu unit);
+
+// A FAP's direction (translations) or axis (rotations) as a unit vector;
+// zero for FAPs without one.
+Eigen::Vector3d fap_direction(const afm_fap_info *info);
 
 }  // namespace afmb

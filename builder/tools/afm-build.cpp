@@ -5,8 +5,14 @@
 #include <string>
 #include <vector>
 
+#include <algorithm>
+
+#include "afm/afm_export.h"
+#include "afm/rigid_parts.h"
 #include "anatomy/face_model.h"
 #include "anatomy/muscle_table.h"
+#include "fap/fap_mapping.h"
+#include "fap/fap_synthesis.h"
 #include "io/load_face.h"
 #include "render/anatomy_render.h"
 
@@ -21,8 +27,10 @@ void usage(FILE *out) {
       "Builds the anatomical face model of a face mesh and its MPEG-4 feature points\n"
       "(docs/anatomy.md): a four-layer mass-spring skin over a skull, the 25 muscles\n"
       "placed from the FDPs, the jaw; calibrates every muscle and prints the model.\n"
-      "Draws pictures of it and solves poses on request. A muscle that is not essential\n"
-      "and lacks FDPs or cannot reach its calibrated range is skipped with a warning.\n"
+      "Draws pictures of it and solves poses on request. With -o, makes a morph target\n"
+      "per FAP (docs/fap_mapping.md) and writes the Animatable Face Model. A muscle\n"
+      "that is not essential and lacks FDPs or cannot reach its calibrated range is\n"
+      "skipped with a warning, and the FAPs that need it are reported.\n"
       "\n"
       "  MESH, FDP               as afm-import (.wrl/.obj/.ply/.off/.stl; XfaceEd, text or\n"
       "                          visage FDPs)\n"
@@ -32,8 +40,8 @@ void usage(FILE *out) {
       "  --solver S              newton (default), newton-rest, implicit-euler (the\n"
       "                          paper's scheme) or newton-jacobi (solver.h; calibration\n"
       "                          always runs a newton solver)\n"
-      "  --threads N             calibration workers (default: one per core; the model\n"
-      "                          is the same for any N)\n"
+      "  --threads N             calibration and synthesis workers (default: one per\n"
+      "                          core; the model and the AFM are the same for any N)\n"
       "  --no-estimates          do not estimate missing FDPs from the reference head:\n"
       "                          muscles lacking FDPs are skipped (or, if essential, the\n"
       "                          build fails)\n"
@@ -48,12 +56,19 @@ void usage(FILE *out) {
       "                          (repeatable; positive is the muscle's action)\n"
       "  --jaw PCT               open the jaw, 0..100 %% (100 %% is 20 degrees)\n"
       "  --pose FILE.png         solve the pose given by --contract/--jaw and draw it\n"
+      "  -o FACE.afm             synthesize the FAP morph targets and write the AFM;\n"
+      "                          prints, per target, the prescribed and achieved FDP\n"
+      "                          motion and the error along and off the FAP's direction\n"
+      "  --profile P             draco (default: compressed) or raw\n"
+      "  --faps LIST             only these FAPs, e.g. 3,12,31 (default: every mapped one)\n"
+      "  --list-faps             how each FAP is made: muscles, jaw, rigid or not at all\n"
       "  --list-muscles          the 25 muscles and their key points\n"
       "  -q, --quiet             no progress lines\n"
       "  --help                  this text\n"
       "\n"
-      "Exit status: 0 on success, 1 on bad input or a solve that does not converge (the\n"
-      "message says which and why), 2 on bad usage.\n");
+      "Exit status: 0 on success (FAPs that cannot be made are reported, not fatal), 1\n"
+      "on bad input or a solve that does not converge (the message says which and\n"
+      "why), 2 on bad usage.\n");
 }
 
 int fail(const Status &s) {
@@ -75,7 +90,10 @@ int main(int argc, char **argv) {
   double jaw_open = 0;
   LoadOptions lo;
   FaceModelOptions fo;
-  bool quiet = false, list = false;
+  bool quiet = false, list = false, list_faps = false;
+  std::string out_path;
+  afm_profile profile = AFM_PROFILE_DRACO;
+  FapSynthesisOptions so;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&](const char *name) -> std::string {
@@ -138,6 +156,30 @@ int main(int argc, char **argv) {
       pose_png = value("--pose");
     } else if (a == "--list-muscles") {
       list = true;
+    } else if (a == "-o") {
+      out_path = value("-o");
+    } else if (a == "--profile") {
+      const std::string p = value("--profile");
+      if (p == "draco") profile = AFM_PROFILE_DRACO;
+      else if (p == "raw") profile = AFM_PROFILE_RAW;
+      else return usage_error("--profile '" + p + "': use draco or raw");
+    } else if (a == "--faps") {
+      const std::string l = value("--faps");
+      size_t at = 0;
+      while (at <= l.size()) {
+        const size_t comma = std::min(l.find(',', at), l.size());
+        const std::string item = l.substr(at, comma - at);
+        char *end = nullptr;
+        const long n = std::strtol(item.c_str(), &end, 10);
+        const FapMapping *m = item.empty() || *end ? nullptr : find_fap_mapping(static_cast<int>(n));
+        if (!m) return usage_error("--faps '" + l + "': '" + item + "' is not a FAP number 3..68");
+        if (m->driver == FapDriver::Rigid || m->driver == FapDriver::None)
+          return usage_error("--faps: FAP " + item + " has no morph target (--list-faps)");
+        so.only.push_back(static_cast<int>(n));
+        at = comma + 1;
+      }
+    } else if (a == "--list-faps") {
+      list_faps = true;
     } else if (a == "-q" || a == "--quiet") {
       quiet = true;
     } else if (a.size() > 1 && a[0] == '-') {
@@ -156,6 +198,10 @@ int main(int argc, char **argv) {
     for (const MuscleDef &d : muscle_table())
       std::printf("%-26s %-9s %-36s %-26s %s\n", d.name, d.kind == MuscleKind::Linear ? "linear" : "sphincter",
                   d.attachment_or_major, d.insertion_or_minor, d.epicentre ? d.epicentre : "-");
+    if (mesh_path.empty() && !list_faps) return 0;
+  }
+  if (list_faps) {
+    std::printf("%s", fap_mapping_text().c_str());
     if (mesh_path.empty()) return 0;
   }
   if (mesh_path.empty() || fdp_path.empty()) {
@@ -169,6 +215,7 @@ int main(int argc, char **argv) {
   for (const auto &inf : influences)
     if (find_muscle(inf.first) < 0) return usage_error("--influence: no muscle '" + inf.first + "' (--list-muscles)");
   if (!pose_png.empty() && !fo.calibrate) return usage_error("--pose needs calibrated muscles (drop --no-calibrate)");
+  if (!out_path.empty() && !fo.calibrate) return usage_error("-o needs calibrated muscles (drop --no-calibrate)");
 
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<std::string> log;
@@ -253,6 +300,57 @@ int main(int argc, char **argv) {
         return fail(s);
       std::printf("wrote %s\n", pose_png.c_str());
     }
+  }
+  if (!out_path.empty()) {
+    const auto t1 = std::chrono::steady_clock::now();
+    if (!quiet)
+      so.progress = [](int done, int total, const std::string &what) {
+        std::fprintf(stderr, "\r[%3d/%3d] %-40s", done, total, what.c_str());
+        if (done == total) std::fprintf(stderr, "\n");
+        std::fflush(stderr);
+      };
+    so.threads = fo.threads;
+    Expected<FapSynthesis> syn = synthesize_faps(face->scene, *model, so);
+    if (!syn) return fail(syn.status());
+    std::printf("%-4s %-24s %6s %8s %10s %10s %8s %8s %7s\n", "fap", "name", "ref", "scale", "prescribed",
+                "achieved", "along", "off-axis", "V_d");
+    std::vector<double> along, off;
+    int failed = 0;
+    for (const FapOutcome &o : syn->outcomes) {
+      const afm_fap_info *info = afm_fap(o.fap);
+      if (!o.made) {
+        ++failed;
+        std::printf("%-4d %-24s %6d  not made: %s\n", o.fap, info->name, o.reference, o.message.c_str());
+        continue;
+      }
+      along.push_back(o.along_error);
+      off.push_back(o.off_axis);
+      std::printf("%-4d %-24s %6d %8.3f %10.4g %10.4g %7.2f%% %7.1f%% %7d%s%s\n", o.fap, info->name, o.reference,
+                  o.scale, o.prescribed.norm(), o.achieved.norm(), 100 * o.along_error, 100 * o.off_axis, o.dynamic,
+                  o.lowered_from ? "  " : "", o.lowered_from ? o.message.c_str() : "");
+    }
+    auto median = [](std::vector<double> v) {
+      if (v.empty()) return 0.0;
+      std::sort(v.begin(), v.end());
+      return v[v.size() / 2];
+    };
+    auto worst = [](const std::vector<double> &v) { return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end()); };
+    std::printf("targets: %zu made, %d not made; along the direction median %.2f%% worst %.2f%%; off-axis median "
+                "%.1f%% worst %.1f%%\n",
+                syn->targets.size(), failed, 100 * median(along), 100 * worst(along), 100 * median(off),
+                100 * worst(off));
+    AfmContent content;
+    content.scene = &face->scene;
+    content.fdps = &face->fdps;
+    content.fapu = model->fapu;
+    content.targets = std::move(syn->targets);
+    content.rigids = eye_and_head_rigids(face->scene, face->fdps, model->fapu, model->skin);
+    if (!syn->jaw.parts.empty()) content.rigids.push_back(syn->jaw);
+    content.generator = "afm-build";
+    if (Status s = write_afm(out_path, content, profile); !s) return fail(s);
+    std::printf("wrote %s (%zu targets, %zu rigid parts) in %.2f s\n", out_path.c_str(), content.targets.size(),
+                content.rigids.size(),
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count());
   }
   return 0;
 }

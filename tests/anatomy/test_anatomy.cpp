@@ -15,30 +15,22 @@
 #include "anatomy/muscle_table.h"
 #include "io/load_face.h"
 #include "refhead/refhead.h"
+#include "../common/reference_model.h"
 #include "../common/test_paths.h"
 
 using namespace afmb;
 
 namespace {
 
-struct Built {
-  RefHead head;
-  FaceModel model;
-};
+using Built = afmtest::ReferenceModel;
 
 // One reference head and its uncalibrated model, shared by the tests.
 const Built &head_1k() {
   static std::unique_ptr<Built> b;
   if (!b) {
-    RefHeadOptions o;
-    o.skin_vertices = 1000;
-    Expected<RefHead> h = make_reference_head(o);
-    EXPECT_TRUE(h.is_ok());
     FaceModelOptions fo;
     fo.calibrate = false;
-    Expected<FaceModel> m = build_face_model(h->scene, h->fdps, fo);
-    EXPECT_TRUE(m.is_ok()) << m.status().message();
-    b = std::make_unique<Built>(Built{std::move(*h), std::move(*m)});
+    b = afmtest::build_reference_model(1000, fo);
   }
   return *b;
 }

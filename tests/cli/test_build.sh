@@ -1,17 +1,30 @@
 #!/bin/sh
 # afm-build: the model summary, the pictures (muscle map, influence, jaw,
-# pose), and its errors (bad usage exits 2, bad input exits 1 naming the
-# file, nothing written).
+# pose), the AFM (-o), and its errors (bad usage exits 2, bad input exits 1
+# naming the file, nothing written).
 test_name=test_build.sh
 . "$(dirname "$0")/lib/common.sh"
 gen="$bin/afm-headgen"
+info="$bin/afm-info"
 bin="$bin/afm-build"
 
 "$bin" --help | grep -q -- "--muscle-map" || fail "--help does not list --muscle-map"
 "$bin" --list-muscles | grep -q "^orbicularis_oris .*sphincter" || fail "--list-muscles lacks orbicularis_oris"
 [ "$("$bin" --list-muscles | grep -c '^[a-z]')" -eq 26 ] || fail "--list-muscles does not list 25 muscles"
 
+"$bin" --list-faps | grep -q "^ 3 open_jaw  *jaw-open" || fail "--list-faps lacks open_jaw"
+[ "$("$bin" --list-faps | grep -c '^ *[0-9]')" -eq 66 ] || fail "--list-faps does not list FAPs 3..68"
+
 "$gen" --vertices 1000 -o "$tmp/h.wrl" >/dev/null 2>&1 || fail "afm-headgen failed"
+
+# An AFM with two FAPs: the report, then the file as afm-info reads it.
+"$bin" "$tmp/h.wrl" "$tmp/h.fdp" -q --faps 3,12 --profile raw -o "$tmp/h.afm" >"$tmp/afm.txt" 2>&1 ||
+  fail "an AFM build failed: $(cat "$tmp/afm.txt")"
+grep -q "^3  *open_jaw  *320 " "$tmp/afm.txt" || fail "no report line for open_jaw: $(cat "$tmp/afm.txt")"
+grep -q "^12  *raise_l_cornerlip  *-" "$tmp/afm.txt" || fail "no negative side for raise_l_cornerlip"
+grep -q "^targets: 3 made, 0 not made" "$tmp/afm.txt" || fail "no summary: $(cat "$tmp/afm.txt")"
+"$info" --targets "$tmp/h.afm" >"$tmp/info.txt" 2>&1 || fail "afm-info cannot read the AFM"
+grep -q "FAP  *3  *open_jaw  *320" "$tmp/info.txt" || fail "afm-info lists no open_jaw target: $(cat "$tmp/info.txt")"
 
 # Placement only: the summary and three pictures.
 "$bin" "$tmp/h.wrl" "$tmp/h.fdp" --no-calibrate -q --muscle-map "$tmp/map.png" \
@@ -35,6 +48,11 @@ expect_error "bad solver" 2 "newton, newton-rest, implicit-euler" - -- "$bin" "$
 expect_error "bad thread count" 2 "use a count" - -- "$bin" "$h" "$f" --threads 0
 expect_error "pose without calibration" 2 "needs calibrated" "$tmp/bad.png" -- \
   "$bin" "$h" "$f" --no-calibrate --jaw 50 --pose "$tmp/bad.png"
+expect_error "AFM without calibration" 2 "needs calibrated" "$tmp/bad.afm" -- \
+  "$bin" "$h" "$f" --no-calibrate -o "$tmp/bad.afm"
+expect_error "bad FAP list" 2 "not a FAP number" "$tmp/bad.afm" -- "$bin" "$h" "$f" --faps 3,x -o "$tmp/bad.afm"
+expect_error "FAP without target" 2 "has no morph target" "$tmp/bad.afm" -- "$bin" "$h" "$f" --faps 48 -o "$tmp/bad.afm"
+expect_error "bad profile" 2 "use draco or raw" "$tmp/bad.afm" -- "$bin" "$h" "$f" --profile zip -o "$tmp/bad.afm"
 
 # Bad input: exit 1 naming the file; nothing written.
 expect_error "missing mesh" 1 "missing.wrl" "$tmp/bad.png" -- \

@@ -1,0 +1,60 @@
+// How each MPEG-4 low-level FAP is made (method paper section 4): the
+// mapping from FAPs to muscle groups, the jaw or a rigid part, as data. The
+// table is in fap_mapping.cpp; docs/fap_mapping.md explains the choices and
+// `afm-build --list-faps` prints it.
+//
+// A muscle group is a pattern of contractions (percent of each muscle's
+// calibrated range, face_model.h). The synthesis (fap_synthesis.h) scales
+// the whole pattern by one factor s > 0 so that the FAP's FDP moves by
+// reference x FAPU along the FAP's direction (MPEG-4 semantics), and the
+// pose it reaches becomes the morph target. So the table fixes which muscles
+// act and in which proportions; the amount comes from the face.
+//
+// Reference values: near the 90th percentile of |value| in the real FAP
+// streams of ../shared/data/fap (docs/fap_mapping.md lists them), so that
+// most frames interpolate and few extrapolate.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace afmb {
+
+enum class FapDriver {
+  Muscles,    // a muscle group: a morph target
+  JawOpen,    // the jaw's rotation: a morph target and the jaw's rigid control
+  JawThrust,  // the jaw's forward translation: likewise
+  JawShift,   // the jaw's sideways translation: likewise
+  Rigid,      // eyeballs and head: a rigid part's control in the AFM, no target
+  None,       // not synthesized; `note` says why
+};
+
+struct FapContraction {
+  const char *muscle;   // FaceModel muscle name
+  double percent;       // contraction at scale 1, -100..100
+};
+
+struct FapMapping {
+  int fap = 0;                              // 3..68
+  FapDriver driver = FapDriver::None;
+  int reference = 0;                        // FAP units (> 0) for targets
+  std::vector<FapContraction> positive;     // the group at +reference
+  // Bidirectional FAPs: the group at -reference (its own target). Empty:
+  // the positive target is extrapolated (the report checks that side).
+  std::vector<FapContraction> negative;
+  const char *note = "";                    // why (None), or a remark
+};
+
+// Every FAP 3..68 once, in number order.
+const std::vector<FapMapping> &fap_mappings();
+
+// The mapping of FAP `fap`, or nullptr when fap is not in 3..68.
+const FapMapping *find_fap_mapping(int fap);
+
+// "muscles", "jaw-open", "jaw-thrust", "jaw-shift", "rigid", "none".
+const char *fap_driver_name(FapDriver driver);
+
+// The table as text, one FAP per line (afm-build --list-faps).
+std::string fap_mapping_text();
+
+}  // namespace afmb

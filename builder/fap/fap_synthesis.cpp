@@ -1,0 +1,254 @@
+#include "fap/fap_synthesis.h"
+
+#include <afm/mpeg4.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <mutex>
+#include <optional>
+#include <thread>
+
+#include "core/fapu.h"
+#include "anatomy/muscle_table.h"
+#include "core/part_kind.h"
+#include "fap/fap_mapping.h"
+
+namespace afmb {
+
+namespace {
+
+bool is_jaw(FapDriver d) { return d == FapDriver::JawOpen || d == FapDriver::JawThrust || d == FapDriver::JawShift; }
+
+// The jaw percentage that moves point p by `value` along `dir` (model units),
+// by bisection on the rigid motion: the chin is carried by the jaw.
+double jaw_percent(const Jaw &jaw, FapDriver d, const Eigen::Vector3d &p, const Eigen::Vector3d &dir, double value) {
+  auto along = [&](double pct) {
+    const Eigen::Affine3d t = jaw_motion(jaw, d == FapDriver::JawOpen ? pct : 0, d == FapDriver::JawThrust ? pct : 0,
+                                         d == FapDriver::JawShift ? pct : 0);
+    return (t * p - p).dot(dir);
+  };
+  // Translations are linear in the percentage, and may run either way.
+  const double sign = d == FapDriver::JawOpen || along(1) >= 0 ? 1.0 : -1.0;
+  double lo = 0, hi = 100;
+  while (along(sign * hi) < value && hi < 1e4) hi *= 2;
+  for (int i = 0; i < 60; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (along(sign * mid) < value ? lo : hi) = mid;
+  }
+  return sign * 0.5 * (lo + hi);
+}
+
+std::string fap_label(int fap, int side) {
+  const afm_fap_info *info = afm_fap(fap);
+  return std::string(info ? info->name : "fap") + (side < 0 ? " (negative)" : "");
+}
+
+}  // namespace
+
+Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &model, const FapSynthesisOptions &options) {
+  if (model.skin < 0 || model.tissue.n == 0) return Status::error("FAP synthesis: the model has no skin");
+  const SkinModel &skin = model.tissue;
+  FapSynthesis out;
+
+  // The work list: (mapping, side).
+  std::vector<std::pair<const FapMapping *, int>> work;
+  for (const FapMapping &m : fap_mappings()) {
+    if (m.driver == FapDriver::Rigid || m.driver == FapDriver::None) continue;
+    if (!options.only.empty() && std::find(options.only.begin(), options.only.end(), m.fap) == options.only.end())
+      continue;
+    for (const std::vector<FapContraction> *g : {&m.positive, &m.negative})
+      for (const FapContraction &c : *g)
+        if (model.find(c.muscle) < 0 && find_muscle(c.muscle) < 0)
+          return Status::error(std::string("FAP synthesis: FAP ") + std::to_string(m.fap) + " names muscle '" +
+                               c.muscle + "', which the muscle table lacks");
+    work.push_back({&m, +1});
+    if (options.negative_sides && !m.negative.empty()) work.push_back({&m, -1});
+  }
+
+  out.jaw.kind = AFM_RIGID_JAW;
+  out.jaw.pivot = model.jaw.pivot;
+  for (PartKind k : {PartKind::TeethLower, PartKind::Tongue})
+    if (int p = scene.find_kind(k); p >= 0) out.jaw.parts.push_back(p);
+
+  // Each target is its own solve: workers take them in turn, and the results
+  // are put together in the work list's order, so the output does not depend
+  // on the number of workers.
+  struct Result {
+    FapOutcome outcome;
+    std::optional<MorphTarget> target;
+    std::optional<RigidPart::Control> control;
+  };
+  std::vector<Result> results(work.size());
+  auto make = [&](size_t k) {
+    const FapMapping *map = work[k].first;
+    const int side = work[k].second;
+    Result &res = results[k];
+    const auto start = std::chrono::steady_clock::now();
+    const afm_fap_info *info = afm_fap(map->fap);
+    FapOutcome o;
+    o.fap = map->fap;
+    o.side = side;
+    o.reference = side * map->reference;
+    const Eigen::Vector3d dir = fap_direction(info);
+    const double unit = fapu_distance(model.fapu, info->unit) / 1024.0;
+    const double value = map->reference * unit;  // along side x dir
+    o.prescribed = side * value * dir;
+    const FdpPoint *fdp = model.fdps.find(FdpId{info->fdp_group, info->fdp_index}, model.skin);
+    Pose pose;
+    bool ok = false;
+    if (!fdp || fdp->part != model.skin || fdp->vertex < 0) {
+      o.message = "its FDP " + std::to_string(info->fdp_group) + "." + std::to_string(info->fdp_index) +
+                  " is not on the skin";
+    } else if (is_jaw(map->driver)) {
+      if (model.jaw.vertices.empty()) {
+        o.message = "the model has no jaw";
+      } else {
+        const Eigen::Vector3d p = skin.X0.row(fdp->vertex).transpose();
+        // The rigid motion of the FDP first; where the chin's vertex is not
+        // carried by the jaw but by the tissue around it, secant steps on
+        // the solved pose then bring it to the value.
+        double pct = jaw_percent(model.jaw, map->driver, p, side * dir, value);
+        FactorCache cache;
+        Expected<Pose> pz = Status::error("no pose");
+        double prev_pct = 0, prev_along = 0, posed = pct;
+        for (int round = 0; round < 6; ++round) {
+          posed = pct;
+          Activation a;
+          (map->driver == FapDriver::JawOpen    ? a.jaw_open
+           : map->driver == FapDriver::JawThrust ? a.jaw_thrust
+                                                 : a.jaw_shift) = pct;
+          pz = solve_pose(model, a, &cache);
+          if (!pz) break;
+          const double along = (pz->X.row(fdp->vertex) - skin.X0.row(fdp->vertex)).dot(side * dir.transpose());
+          if (std::abs(along - value) <= model.solver.tolerance) break;
+          const double next = prev_along != along ? pct + (value - along) * (pct - prev_pct) / (along - prev_along)
+                                                  : pct * value / along;
+          prev_pct = pct, prev_along = along;
+          pct = next;
+        }
+        pct = posed;  // the pose's own
+        o.scale = pct / 100.0;
+        if (!pz) {
+          o.message = pz.status().message();
+        } else {
+          pose = std::move(*pz);
+          ok = true;
+          RigidPart::Control c;
+          c.fap = map->fap;
+          if (map->driver == FapDriver::JawOpen) {
+            c.dof = AFM_DOF_ROTATE_X;
+            c.gain = pct / 100.0 * model.jaw.max_open / map->reference / 1e-5;  // AU per FAP unit
+          } else if (map->driver == FapDriver::JawThrust) {
+            c.dof = AFM_DOF_TRANSLATE_Z;
+            c.gain = pct / 100.0 * model.jaw.max_thrust / map->reference;
+          } else {
+            c.dof = AFM_DOF_TRANSLATE_X;
+            c.gain = pct / 100.0 * model.jaw.max_shift / map->reference;
+          }
+          if (side > 0) res.control = c;
+        }
+      }
+    } else {
+      std::vector<std::pair<int, double>> pattern;
+      std::string missing;
+      for (const FapContraction &c : side > 0 ? map->positive : map->negative) {
+        const int i = model.find(c.muscle);
+        if (i < 0) missing += (missing.empty() ? "" : ", ") + std::string(c.muscle);
+        else pattern.push_back({i, c.percent});
+      }
+      if (!missing.empty()) {
+        o.message = "the model lacks " + missing + " (skipped when the model was built)";
+      } else {
+        const int node = skin.node(kEpidermis, fdp->vertex);
+        const Eigen::Vector3d along = side * dir;
+        PoseAction action = [&skin, node, along](const Eigen::MatrixXd &X, Eigen::MatrixXd *g) {
+          if (g) g->row(node) += along.transpose();
+          return (X.row(node) - skin.X0.row(node)).dot(along.transpose());
+        };
+        FactorCache cache;
+        double scale = 0;
+        Expected<Pose> pz = solve_pose_to(model, pattern, action, value, &cache, &scale);
+        if (pz && scale <= 1) {
+          pose = std::move(*pz);
+          o.scale = scale;
+          ok = true;
+        } else {
+          // Out of the muscles' calibrated range: the target is the group at
+          // its table contractions, and the reference what that reaches.
+          const std::string why = pz ? "it needs " + std::to_string(static_cast<int>(std::lround(100 * scale))) +
+                                           " % of the table's contractions"
+                                     : pz.status().message();
+          Activation a;
+          a.muscles = pattern;
+          Expected<Pose> full = solve_pose(model, a, &cache);
+          if (!full) {
+            o.message = full.status().message();
+          } else {
+            const double reach = action(full->X, nullptr);
+            const int r = static_cast<int>(std::floor(reach / unit));
+            if (r < 1) {
+              o.message = reach <= 0 ? "the group moves the FDP the wrong way" : "the group moves the FDP less than a FAP unit";
+              o.message += " (reference " + std::to_string(map->reference) + ": " + why + ")";
+            } else {
+              pose = std::move(*full);
+              o.scale = 1;
+              o.lowered_from = map->reference;
+              o.reference = side * r;
+              o.prescribed = side * r * unit * dir;
+              o.message = "reference lowered from " + std::to_string(map->reference) + ": " + why;
+              ok = true;
+            }
+          }
+        }
+      }
+    }
+    if (ok) {
+      const Eigen::MatrixXd D = pose_epidermis(model, pose) - skin.X0.topRows(skin.n);
+      o.achieved = D.row(fdp->vertex).transpose();
+      const double len = o.prescribed.norm();
+      const double a = o.achieved.dot(dir);
+      o.along_error = std::abs(a - o.prescribed.dot(dir)) / len;
+      o.off_axis = (o.achieved - a * dir).norm() / len;
+      o.dynamic = static_cast<int>(pose.dynamic.size());
+      o.made = true;
+      MorphTarget t;
+      t.kind = AFM_TARGET_FAP;
+      t.number = map->fap;
+      t.reference = o.reference;
+      t.displacement.assign(scene.parts.size(), Eigen::MatrixXd());
+      t.displacement[static_cast<size_t>(model.skin)] = D;
+      res.target = std::move(t);
+    }
+    o.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    res.outcome = std::move(o);
+  };
+  std::atomic<size_t> next{0};
+  std::mutex lock;
+  int done = 0;
+  auto worker = [&] {
+    for (size_t k; (k = next++) < work.size();) {
+      make(k);
+      std::lock_guard<std::mutex> g(lock);
+      if (options.progress)
+        options.progress(++done, static_cast<int>(work.size()), fap_label(work[k].first->fap, work[k].second));
+    }
+  };
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  const size_t workers = std::min<size_t>(work.size(), options.threads > 0 ? static_cast<size_t>(options.threads) : cores);
+  std::vector<std::thread> pool;
+  for (size_t w = 1; w < workers; ++w) pool.emplace_back(worker);
+  worker();
+  for (std::thread &t : pool) t.join();
+  for (Result &r : results) {
+    if (r.target) out.targets.push_back(std::move(*r.target));
+    if (r.control) out.jaw.controls.push_back(*r.control);
+    out.outcomes.push_back(std::move(r.outcome));
+  }
+  if (out.jaw.controls.empty()) out.jaw.parts.clear();
+  return out;
+}
+
+}  // namespace afmb

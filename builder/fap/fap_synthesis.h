@@ -1,0 +1,76 @@
+// FAP synthesis (method paper section 4): one morph target per low-level FAP
+// (and per side of a bidirectional one), from the anatomical face model and
+// the mapping of fap_mapping.h.
+//
+// For each FAP with a muscle group: the group is scaled by one factor found
+// with the pose (face_model.h, solve_pose_to) so that the FAP's FDP moves by
+// reference x FAPU along the FAP's direction (negative side: -reference);
+// the pose's epidermis minus the rest is the target. The jaw FAPs (3, 14,
+// 15) set the jaw's rotation or translation so that the chin (2.1) moves by
+// the same rule, then solve the tissue around it; the jaw's rigid parts
+// (lower teeth, tongue) get a control with the same motion.
+//
+// The scale stays within the muscles' calibrated range (s <= 1 with the
+// table's contractions at 100 %). A group that cannot reach the reference
+// there makes its target at s = 1, and the reference becomes what it reaches
+// (rounded down to whole FAP units): the MPEG-4 rule still holds, and the
+// outcome says the reference was lowered and why. A group that moves its
+// FDP the wrong way, or by less than a FAP unit, gets no target.
+//
+// What is measured per target (the fidelity report): the prescribed FDP
+// displacement, the achieved one, the error along the FAP's direction and
+// off it, both relative to the prescribed length. Along the direction the
+// error is the solver's tolerance (or the rounding of a lowered reference)
+// by construction; off it is the anatomy's answer.
+#pragma once
+
+#include <Eigen/Core>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "afm/afm_export.h"
+#include "anatomy/face_model.h"
+#include "core/status.h"
+
+namespace afmb {
+
+struct FapOutcome {
+  int fap = 0;
+  int side = +1;                  // +1: the positive reference, -1: the negative one
+  int reference = 0;              // signed FAP units
+  bool made = false;              // a target was made
+  std::string message;            // why not, when !made; why the reference was lowered
+  int lowered_from = 0;           // the table's reference when the group could not reach it
+                                  // within its calibrated range (else 0)
+  Eigen::Vector3d prescribed = Eigen::Vector3d::Zero();  // FDP displacement, model units
+  Eigen::Vector3d achieved = Eigen::Vector3d::Zero();
+  double along_error = 0;         // |achieved . dir - prescribed . dir| / |prescribed|
+  double off_axis = 0;            // |achieved - (achieved . dir) dir| / |prescribed|
+  double scale = 0;               // muscle groups: the factor on the table's contractions
+  int dynamic = 0;                // vertices solved
+  double seconds = 0;
+};
+
+struct FapSynthesisOptions {
+  std::vector<int> only;          // FAP numbers to make (empty: every mapped one)
+  bool negative_sides = true;     // make the negative side's own target where the table has one
+  // Workers (0: one per core). The targets are the same for any number.
+  int threads = 0;
+  // Called after each target: done of total, and which (from the workers,
+  // one call at a time).
+  std::function<void(int done, int total, const std::string &what)> progress;
+};
+
+struct FapSynthesis {
+  std::vector<MorphTarget> targets;  // the made ones, in FAP order, positive side first
+  std::vector<FapOutcome> outcomes;  // every attempted one, in the same order
+  RigidPart jaw;                     // the jaw's rigid parts and controls (parts empty: none)
+};
+
+// Fails only on an inconsistent model (no skin, a mapping naming an unknown
+// muscle); a FAP that cannot be made is an outcome with made = false.
+Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &model,
+                                       const FapSynthesisOptions &options = {});
+
+}  // namespace afmb
