@@ -107,9 +107,9 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         o.message = "the model has no jaw";
       } else {
         const Eigen::Vector3d p = skin.X0.row(fdp->vertex).transpose();
-        // The rigid motion of the FDP first; where the chin's vertex is not
-        // carried by the jaw but by the tissue around it, secant steps on
-        // the solved pose then bring it to the value.
+        // The jaw moves the bone; the skin over it follows through the
+        // tissue, a few percent short or beyond. So: the bone's motion at
+        // the FDP first, then secant steps on the solved pose.
         double pct = jaw_percent(model.jaw, map->driver, p, side * dir, value);
         FactorCache cache;
         Expected<Pose> pz = Status::error("no pose");
