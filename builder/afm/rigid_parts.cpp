@@ -40,7 +40,8 @@ std::vector<RigidPart> eye_and_head_rigids(const Scene &scene, const FdpSet &fdp
   if (const FdpPoint *spine = fdps.find(FdpId{7, 1}))
     head.pivot = spine->pos;
   else
-    head.pivot = scene.parts[static_cast<size_t>(skin)].V.colwise().mean().transpose() - Eigen::Vector3d(0, 0.5 * fapu.es0, 0);
+    head.pivot = scene.parts[static_cast<size_t>(skin)].V.colwise().mean().transpose() -
+                 Eigen::Vector3d(0, 0.5 * fapu.es0, 0);
   for (size_t p = 0; p < scene.parts.size(); ++p) head.parts.push_back(static_cast<int>(p));
   for (int fap : {48, 49, 50}) {
     Eigen::Vector3d a = fap_direction(afm_fap(fap));

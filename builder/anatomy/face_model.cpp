@@ -261,8 +261,21 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
         what = m.name;
         Expected<std::vector<int>> set = wave_estimate(model, m);
         Status s = set ? Status::ok() : set.status().wrap("calibrating " + m.name);
-        if (s) s = calibrate_side(model, m, false, &cache, *set);
-        if (s) s = calibrate_side(model, m, true, &cache, *set);
+        // A muscle whose tissue locks before its key node reaches the
+        // table's range calibrates to a half, a quarter or an eighth of it instead
+        // (not an essential one: its range is what the FAPs rely on).
+        auto side = [&](bool maximum) {
+          Status st = calibrate_side(model, m, maximum, &cache, *set);
+          double &range = maximum ? m.range_max : m.range_min;
+          while (!st && range > 0.125 && !table[static_cast<size_t>(m.def)].essential &&
+                 st.message().find("cannot take the action") != std::string::npos) {
+            range /= 2;
+            st = calibrate_side(model, m, maximum, &cache, *set);
+          }
+          return st;
+        };
+        if (s) s = side(false);
+        if (s) s = side(true);
         if (s) m.dynamic = std::move(*set);  // grown by both sides: V_d
         result[k] = s;
       } else {
@@ -292,8 +305,19 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
       return failed[i]->wrap("essential muscle");
   std::vector<Muscle> kept;
   for (size_t i = 0; i < model.muscles.size(); ++i) {
-    if (failed[i]) model.warnings.push_back(failed[i]->message() + ": skipped");
-    else kept.push_back(std::move(model.muscles[i]));
+    const Muscle &m = model.muscles[i];
+    if (failed[i]) {
+      model.warnings.push_back(failed[i]->message() + ": skipped");
+      continue;
+    }
+    for (const auto &[range, what] : {std::pair{m.range_max, "+100"}, std::pair{m.range_min, "-100"}})
+      if (range < 1)
+        model.warnings.push_back(m.name + ": its tissue locks before the key node reaches the table's " + what +
+                                 " % (" + std::to_string(std::abs(muscle_action_target(m, std::string(what) == "+100") /
+                                                                  range)) +
+                                 " model units): " + what + " % stands for " + (range == 0.5 ? "a half" : range == 0.25 ? "a quarter" : "an eighth") +
+                                 " of it");
+    kept.push_back(std::move(model.muscles[i]));
   }
   model.muscles = std::move(kept);
   if (!options.calibrate_jaw) return model;

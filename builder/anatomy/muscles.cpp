@@ -251,7 +251,7 @@ double muscle_action(const SkinModel &skin, const Muscle &m, const Eigen::Matrix
 double muscle_action_target(const Muscle &m, bool maximum) {
   const MuscleDef &d = muscle_table()[static_cast<size_t>(m.def)];
   const double scale = m.kind == MuscleKind::Linear ? m.length : (d.calibrate_minor ? m.semi_b : m.semi_a);
-  return maximum ? d.max_fraction * scale : -d.min_fraction * scale;
+  return maximum ? d.max_fraction * m.range_max * scale : -d.min_fraction * m.range_min * scale;
 }
 
 }  // namespace afmb

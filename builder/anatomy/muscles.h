@@ -61,6 +61,10 @@ struct Muscle {
   std::vector<double> weight;   // per influence vertex
   // Calibration (section 3.3): tension at +100 % and at -100 % contraction.
   double tension_max = 0, tension_min = 0;
+  // The part of the table's range (max_fraction, min_fraction) that +-100 %
+  // stands for: 1, or 1/2, 1/4 or 1/8 when the tissue locked before the key node
+  // got there (a non-essential muscle; the model's warnings say so).
+  double range_max = 1, range_min = 1;
   std::vector<int> dynamic;     // V_d: vertices the elastic wave moves, sorted
 };
 
@@ -115,7 +119,8 @@ double muscle_load(const SkinModel &skin, const Muscle &m, double tension, const
 // given, adds the action's gradient with respect to X (4n x 3) to it.
 double muscle_action(const SkinModel &skin, const Muscle &m, const Eigen::MatrixXd &X,
                      Eigen::MatrixXd *gradient = nullptr);
-// The action at +100 % (positive) and at -100 % (negative) contraction.
+// The action at +100 % (positive) and at -100 % (negative) contraction: the
+// table's fraction of the fibre (or semi-axis) times range_max / range_min.
 double muscle_action_target(const Muscle &m, bool maximum);
 
 }  // namespace afmb

@@ -190,7 +190,8 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
             const double reach = action(full->X, nullptr);
             const int r = static_cast<int>(std::floor(reach / unit));
             if (r < 1) {
-              o.message = reach <= 0 ? "the group moves the FDP the wrong way" : "the group moves the FDP less than a FAP unit";
+              o.message = reach <= 0 ? "the group moves the FDP the wrong way"
+                                     : "the group moves the FDP less than a FAP unit";
               o.message += " (reference " + std::to_string(map->reference) + ": " + why + ")";
             } else {
               pose = std::move(*full);
@@ -237,7 +238,8 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     }
   };
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
-  const size_t workers = std::min<size_t>(work.size(), options.threads > 0 ? static_cast<size_t>(options.threads) : cores);
+  const size_t wanted = options.threads > 0 ? static_cast<size_t>(options.threads) : cores;
+  const size_t workers = std::min<size_t>(work.size(), wanted);
   std::vector<std::thread> pool;
   for (size_t w = 1; w < workers; ++w) pool.emplace_back(worker);
   worker();

@@ -485,6 +485,38 @@ TEST(Calibration, FullContractionMovesTheKeyNodeByItsTarget) {
   }
 }
 
+// Song's eye sphincter: its key point 3.9 is estimated on the lid's border
+// with the cheek, over bone, and cannot travel the table's 50 % of the
+// semi-axis (4.7 units). It calibrates to a smaller part of the range, says
+// so, and +100 % then meets that part.
+TEST(Calibration, SongsEyeSphincterCalibratesToTheRangeItsTissueAllows) {
+  AFM_REQUIRE_SHARED_DATA();
+  Expected<LoadedFace> f = load_face(afmtest::shared_data("faces/song/song.WRL"),
+                                     afmtest::shared_data("faces/song/song.fdp"), LoadOptions{}, nullptr);
+  ASSERT_TRUE(f.is_ok()) << f.status().message();
+  FaceModelOptions fo;
+  fo.calibrate_only = {"orbicularis_oculi_left"};
+  fo.calibrate_jaw = false;
+  Expected<FaceModel> m = build_face_model(f->scene, f->fdps, fo);
+  ASSERT_TRUE(m.is_ok()) << m.status().message();
+  const int i = m->find("orbicularis_oculi_left");
+  ASSERT_GE(i, 0) << "kept, not skipped";
+  const Muscle &mu = m->muscles[static_cast<size_t>(i)];
+  EXPECT_LT(mu.range_max, 1.0);
+  EXPECT_GE(mu.range_max, 0.125);
+  bool said = false;
+  for (const std::string &w : m->warnings) said |= w.find("orbicularis_oculi_left: its tissue locks") == 0;
+  EXPECT_TRUE(said);
+  const MuscleDef &d = muscle_table()[static_cast<size_t>(mu.def)];
+  EXPECT_NEAR(muscle_action_target(mu, true), d.max_fraction * mu.range_max * mu.semi_b, 1e-12);
+  Activation a;
+  a.muscles = {{i, 100.0}};
+  FactorCache cache;
+  Expected<Pose> p = solve_pose(*m, a, &cache);
+  ASSERT_TRUE(p.is_ok()) << p.status().message();
+  EXPECT_NEAR(muscle_action(m->tissue, mu, p->X), muscle_action_target(mu, true), 4 * m->solver.tolerance);
+}
+
 TEST(Calibration, TheSameOnAnyNumberOfThreads) {
   const Built &b = head_1k();
   FaceModelOptions fo;
