@@ -35,6 +35,20 @@ const Built &head_1k() {
   return *b;
 }
 
+// The Song head and its FDPs from ../shared/data.
+Expected<LoadedFace> load_song(const LoadOptions &lo = {}) {
+  return load_face(afmtest::shared_data("faces/song/song.WRL"), afmtest::shared_data("faces/song/song.fdp"), lo,
+                   nullptr);
+}
+
+// Song's model with only `muscle` calibrated and no jaw.
+Expected<FaceModel> song_model(const LoadedFace &f, const std::string &muscle) {
+  FaceModelOptions fo;
+  fo.calibrate_only = {muscle};
+  fo.calibrate_jaw = false;
+  return build_face_model(f.scene, f.fdps, fo);
+}
+
 // The set without FDP `id`.
 FdpSet without(FdpSet f, const std::string &id) {
   f.points.erase(std::remove_if(f.points.begin(), f.points.end(), [&](const FdpPoint &p) { return p.id.str() == id; }),
@@ -491,13 +505,9 @@ TEST(Calibration, FullContractionMovesTheKeyNodeByItsTarget) {
 // so, and +100 % then meets that part.
 TEST(Calibration, SongsEyeSphincterCalibratesToTheRangeItsTissueAllows) {
   AFM_REQUIRE_SHARED_DATA();
-  Expected<LoadedFace> f = load_face(afmtest::shared_data("faces/song/song.WRL"),
-                                     afmtest::shared_data("faces/song/song.fdp"), LoadOptions{}, nullptr);
+  Expected<LoadedFace> f = load_song();
   ASSERT_TRUE(f.is_ok()) << f.status().message();
-  FaceModelOptions fo;
-  fo.calibrate_only = {"orbicularis_oculi_left"};
-  fo.calibrate_jaw = false;
-  Expected<FaceModel> m = build_face_model(f->scene, f->fdps, fo);
+  Expected<FaceModel> m = song_model(*f, "orbicularis_oculi_left");
   ASSERT_TRUE(m.is_ok()) << m.status().message();
   const int i = m->find("orbicularis_oculi_left");
   ASSERT_GE(i, 0) << "kept, not skipped";
@@ -636,8 +646,7 @@ TEST(FdpCompletion, EstimatesLandNearTheTrueFdps) {
 // affine fit, 4.6 (0.14 ES0). Bound: 0.12 ES0.
 TEST(FdpCompletion, SongsFdpsLeftOutComeBackNearby) {
   AFM_REQUIRE_SHARED_DATA();
-  Expected<LoadedFace> f = load_face(afmtest::shared_data("faces/song/song.WRL"),
-                                     afmtest::shared_data("faces/song/song.fdp"), LoadOptions{}, nullptr);
+  Expected<LoadedFace> f = load_song();
   ASSERT_TRUE(f.is_ok()) << f.status().message();
   const int skin = f->scene.find_kind(PartKind::Skin);
   Expected<Fapu> fapu = compute_fapu(f->fdps);
@@ -661,13 +670,9 @@ TEST(Builds, SongHeadPlacesItsMusclesAndJaw) {
   AFM_REQUIRE_SHARED_DATA();
   LoadOptions lo;
   lo.flip_v = true;
-  Expected<LoadedFace> f = load_face(afmtest::shared_data("faces/song/song.WRL"),
-                                     afmtest::shared_data("faces/song/song.fdp"), lo, nullptr);
+  Expected<LoadedFace> f = load_song(lo);
   ASSERT_TRUE(f.is_ok()) << f.status().message();
-  FaceModelOptions fo;
-  fo.calibrate_only = {"zygomaticus_major_left"};
-  fo.calibrate_jaw = false;
-  Expected<FaceModel> m = build_face_model(f->scene, f->fdps, fo);
+  Expected<FaceModel> m = song_model(*f, "zygomaticus_major_left");
   ASSERT_TRUE(m.is_ok()) << m.status().message();
   EXPECT_EQ(m->muscles.size(), 25u);
   EXPECT_GE(m->notes.size(), 10u) << "Song lacks the hairline, eye corners, jaw corners...";
