@@ -350,7 +350,8 @@ Status muscle_set(const FaceModel &model, const std::vector<std::pair<int, doubl
 }  // namespace
 
 Expected<Pose> solve_pose_to(const FaceModel &model, const std::vector<std::pair<int, double>> &pattern,
-                             const PoseAction &action, double value, FactorCache *cache, double *scale) {
+                             const PoseAction &action, double value, FactorCache *cache, double *scale,
+                             double max_scale, bool *capped) {
   Pose pose;
   pose.X = model.tissue.X0;
   std::vector<int> set;
@@ -360,11 +361,13 @@ Expected<Pose> solve_pose_to(const FaceModel &model, const std::vector<std::pair
   control.unit_load = activation_forces(model, pattern);
   control.action = action;
   control.value = value;
+  control.max_tension = max_scale;
   FactorCache local;
   Status s = solve_growing(model, set, nullptr, model.tissue.X0, pose.X, model.solver, model.wave_threshold,
                            cache ? cache : &local, false, &pose.stats, &pose.rounds, &control);
   if (!s) return s.wrap("pose");
   if (scale) *scale = control.tension;
+  if (capped) *capped = control.capped;
   pose.dynamic = std::move(set);
   return pose;
 }

@@ -119,10 +119,14 @@ using PoseAction = std::function<double(const Eigen::MatrixXd &X, Eigen::MatrixX
 // The pose in which `action` reaches `value`: the muscles of `pattern`
 // (percent, -100..100 each) scaled together by one factor s > 0, found with
 // the pose (solver.h, load control). s above 1 extrapolates the calibrated
-// tensions linearly. *scale gets s. Fails as solve_pose does, and when the
-// group cannot take the action to `value` (the message says how far it got).
+// tensions linearly. *scale gets s. With max_scale > 0, s stops there: the
+// pose is then the equilibrium at s = max_scale, its action short of
+// `value`, and *capped (when given) is set. Fails as solve_pose does, and when
+// the group cannot take the action to `value` (the message says how far it
+// got).
 Expected<Pose> solve_pose_to(const FaceModel &model, const std::vector<std::pair<int, double>> &pattern,
-                             const PoseAction &action, double value, FactorCache *cache, double *scale);
+                             const PoseAction &action, double value, FactorCache *cache, double *scale,
+                             double max_scale = 0, bool *capped = nullptr);
 
 // The epidermis of a pose, #V x 3 (the skin part's vertex positions).
 Eigen::MatrixXd pose_epidermis(const FaceModel &model, const Pose &pose);

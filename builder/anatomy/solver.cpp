@@ -605,6 +605,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     return done(false, "solver: implicit-euler cannot solve for a tension (use a newton solver)");
   if (control && !(control->unit_load && control->action))
     return done(false, "solver: a load control needs a unit load and an action");
+  if (control) control->capped = false;
   std::unique_ptr<FactorCache::Entry> own;
   FactorCache::Entry *entry = entry_for(model, vertices, cache, own);
   const System &sys = *entry->sys;
@@ -734,7 +735,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
       contacts.filter(cgrad);
       if (!(cgrad.squaredNorm() > 0)) return done(false, name + ": the controlled action does not depend on the dynamic set");
     }
-    const bool on_target = !control || std::abs(action - control->value) < tol;
+    const bool on_target = !control || control->capped || std::abs(action - control->value) < tol;
     if (it > 0 && st.residual < tol && st.last_step < tol && on_target) break;
     if (it >= max_it) {
       st.contacts = contacts.active;
@@ -815,6 +816,10 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
       // Bounded steps: the tissue stiffens, and far from the equilibrium
       // the linearised action is a rough guide.
       if (t > 0) t_new = std::clamp(t_new, 0.5 * t, 4 * t);
+      if (control->max_tension > 0 && (control->capped || t_new >= control->max_tension)) {
+        control->capped = true;
+        t_new = control->max_tension;
+      }
       if (!(t_new > 0)) return done(false, name + ": the load moves the controlled action the wrong way");
       if (!std::isfinite(t_new)) return done(false, name + ": non-finite tension");
       if (t_ref == 0) t_ref = t_new;

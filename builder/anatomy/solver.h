@@ -63,6 +63,7 @@
 // u = K^-1 r and w = K^-1 g (g the unit load), t moves by dt such that the
 // linearised action of X + u + dt w meets the value, and the step is
 // u + dt w (t grows at most fourfold per step, since the tissue stiffens).
+// With max_tension, t stops there and the solve finishes at that load.
 // The newton solvers only.
 //
 // Stopping rule, the same for all three, with tol = SolverOptions::tolerance
@@ -159,6 +160,12 @@ struct LoadControl {
   std::function<double(const Eigen::MatrixXd &X, Eigen::MatrixXd *gradient)> action;
   double value = 0;    // the action wanted
   double tension = 0;  // in: the start (0: from rest); out: the tension found (> 0)
+  // > 0: the tension may not pass this. Once a step would, the tension stays
+  // there, the action's equation is dropped, and the solve ends at the
+  // equilibrium under that load with `capped` set (the action short of the
+  // value): one solve instead of a failed one and a second.
+  double max_tension = 0;
+  bool capped = false;  // out
 };
 
 // Solves for equilibrium on `vertices` (sorted, unique skin vertex indices;

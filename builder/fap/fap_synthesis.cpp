@@ -170,20 +170,25 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         };
         FactorCache cache;
         double scale = 0;
-        Expected<Pose> pz = solve_pose_to(model, pattern, action, value, &cache, &scale);
-        if (pz && scale <= 1) {
+        bool capped = false;
+        // Within the calibrated range: the scale stops at 1 (the table's
+        // contractions), and the pose is then the group at 1.
+        Expected<Pose> pz = solve_pose_to(model, pattern, action, value, &cache, &scale, 1.0, &capped);
+        if (pz && !capped) {
           pose = std::move(*pz);
           o.scale = scale;
           ok = true;
         } else {
-          // Out of the muscles' calibrated range: the target is the group at
-          // its table contractions, and the reference what that reaches.
-          const std::string why = pz ? "it needs " + std::to_string(static_cast<int>(std::lround(100 * scale))) +
-                                           " % of the table's contractions"
-                                     : pz.status().message();
-          Activation a;
-          a.muscles = pattern;
-          Expected<Pose> full = solve_pose(model, a, &cache);
+          // The reference is what the group reaches at its table
+          // contractions. Where the load control failed (the FDP moves the
+          // wrong way), a plain pose says how far and which way.
+          const std::string why = pz ? "the table's contractions reach less" : pz.status().message();
+          Expected<Pose> full = std::move(pz);
+          if (!full) {
+            Activation a;
+            a.muscles = pattern;
+            full = solve_pose(model, a, &cache);
+          }
           if (!full) {
             o.message = full.status().message();
           } else {

@@ -16,6 +16,7 @@
 #include "afm/rigid_parts.h"
 #include "anatomy/face_model.h"
 #include "anatomy/muscle_table.h"
+#include "anatomy/muscles.h"
 #include "core/fapu.h"
 #include "fap/fap_mapping.h"
 #include "fap/fap_synthesis.h"
@@ -185,6 +186,35 @@ TEST(FapSynthesis, AnUnknownMuscleIsAnErrorAndAMissingOneAReport) {
   EXPECT_FALSE(r->outcomes[0].made);
   EXPECT_NE(r->outcomes[0].message.find("corrugator_left"), std::string::npos) << r->outcomes[0].message;
   EXPECT_TRUE(r->targets.empty());
+}
+
+// A pose steered past what the group can do within its calibrated range
+// stops at scale 1: the same pose as the group at its table contractions.
+TEST(FapSynthesis, ASteeredPoseStopsAtTheCalibratedRange) {
+  const FaceModel &m = head_1k().model;
+  const int i = m.find("zygomaticus_major_left");
+  const Muscle &mu = m.muscles[static_cast<size_t>(i)];
+  const std::vector<std::pair<int, double>> pattern = {{i, 100.0}};
+  PoseAction action = [&](const Eigen::MatrixXd &X, Eigen::MatrixXd *g) { return muscle_action(m.tissue, mu, X, g); };
+  FactorCache cache;
+  double scale = 0;
+  bool capped = false;
+  Expected<Pose> p = solve_pose_to(m, pattern, action, 3 * muscle_action_target(mu, true), &cache, &scale, 1.0, &capped);
+  ASSERT_TRUE(p.is_ok()) << p.status().message();
+  EXPECT_TRUE(capped);
+  EXPECT_EQ(scale, 1.0);
+  Activation a;
+  a.muscles = pattern;
+  Expected<Pose> full = solve_pose(m, a, &cache);
+  ASSERT_TRUE(full.is_ok());
+  EXPECT_LT((pose_epidermis(m, *p) - pose_epidermis(m, *full)).cwiseAbs().maxCoeff(), 4 * m.solver.tolerance);
+  EXPECT_NEAR(muscle_action(m.tissue, mu, p->X), muscle_action_target(mu, true), 4 * m.solver.tolerance);
+  // Within reach, the cap does not bite.
+  p = solve_pose_to(m, pattern, action, 0.5 * muscle_action_target(mu, true), &cache, &scale, 1.0, &capped);
+  ASSERT_TRUE(p.is_ok());
+  EXPECT_FALSE(capped);
+  EXPECT_LT(scale, 1.0);
+  EXPECT_NEAR(muscle_action(m.tissue, mu, p->X), 0.5 * muscle_action_target(mu, true), 4 * m.solver.tolerance);
 }
 
 TEST(FapSynthesis, TheSameOnAnyNumberOfThreads) {
