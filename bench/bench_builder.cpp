@@ -14,7 +14,6 @@
 #include <string>
 
 #include "afm/afm_export.h"
-#include "afm/rigid_parts.h"
 #include "anatomy/face_model.h"
 #include "fap/fap_synthesis.h"
 #include "io/load_face.h"
@@ -50,21 +49,16 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
   Expected<FapSynthesis> syn = synthesize_faps(scene, *m);
   if (syn) {
     const double t_targets = now() - t1;
-    AfmContent c;
-    c.scene = &scene;
-    c.fdps = &fdps;
-    c.fapu = m->fapu;
-    c.targets = syn->targets;
-    c.rigids = eye_and_head_rigids(scene, fdps, m->fapu, m->skin);
-    if (!syn->jaw.parts.empty()) c.rigids.push_back(syn->jaw);
-    Expected<std::vector<uint8_t>> bytes = encode_afm(c, AFM_PROFILE_DRACO);
     std::vector<double> off;
     for (const FapOutcome &o : syn->outcomes)
       if (o.made) off.push_back(o.off_axis);
     std::sort(off.begin(), off.end());
+    const size_t made = syn->targets.size(), tried = syn->outcomes.size();
+    Expected<std::vector<uint8_t>> bytes =
+        encode_afm(fap_afm_content(scene, fdps, *m, std::move(*syn)), AFM_PROFILE_DRACO);
     std::printf("FAP targets: %zu of %zu made in %.2f s; AFM %s, %.2f s in all with the model; off-axis median "
                 "%.0f %%\n",
-                syn->targets.size(), syn->outcomes.size(), t_targets,
+                made, tried, t_targets,
                 bytes ? (std::to_string(bytes->size()) + " bytes").c_str() : bytes.status().message().c_str(),
                 now() - t0, off.empty() ? 0.0 : 100 * off[off.size() / 2]);
   } else {

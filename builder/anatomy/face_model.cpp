@@ -1,14 +1,13 @@
 #include "anatomy/face_model.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <mutex>
-#include <thread>
 
 #include "afm/afm_export.h"
 #include "anatomy/fdp_completion.h"
 #include "core/orient.h"
+#include "core/parallel.h"
 #include "core/validate.h"
 
 namespace afmb {
@@ -154,7 +153,9 @@ Expected<std::vector<int>> wave_estimate(const FaceModel &model, const Muscle &m
 // Finds the tension giving the +100 % (maximum) or -100 % action (section
 // 3.3): one equilibrium solve with the tension as an unknown (solver.h, load
 // control), on `set`, grown while the wave reaches its border.
-Status calibrate_side(const FaceModel &model, Muscle &m, bool maximum, FactorCache *cache, std::vector<int> &set) {
+// *locked: it failed because the tissue locked before the key node got there.
+Status calibrate_side(const FaceModel &model, Muscle &m, bool maximum, FactorCache *cache, std::vector<int> &set,
+                      bool *locked) {
   LoadControl control;
   control.unit_load = unit_load(model, m, maximum ? 1.0 : -1.0);
   control.action = [&](const Eigen::MatrixXd &X, Eigen::MatrixXd *g) { return muscle_action(model.tissue, m, X, g); };
@@ -164,6 +165,7 @@ Status calibrate_side(const FaceModel &model, Muscle &m, bool maximum, FactorCac
   Eigen::MatrixXd X = model.tissue.X0;
   Status s = solve_growing(model, set, nullptr, model.tissue.X0, X, opts, model.wave_threshold, cache, false,
                            nullptr, nullptr, &control);
+  if (locked) *locked = !s && control.unreachable;
   if (!s)
     return s.wrap("calibrating " + m.name + ": the " + (maximum ? "maximum" : "minimum") +
                   " contraction (moving its key node " + std::to_string(std::abs(control.value)) +
@@ -248,52 +250,42 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
   std::vector<Status> result(tasks);
   Expected<Pose> jaw_pose = Status::error("jaw: not solved");
   model.jaw.dynamic = model.jaw.vertices;
-  std::atomic<size_t> next{0};
   std::mutex lock;
   int finished = 0;
   const int total = static_cast<int>(tasks);
-  auto work = [&] {
+  for_each_task(tasks, options.threads, [&](size_t k) {
     FactorCache cache;
-    for (size_t k; (k = next++) < tasks;) {
-      std::string what = "jaw";
-      if (k < todo.size()) {
-        Muscle &m = model.muscles[todo[k]];
-        what = m.name;
-        Expected<std::vector<int>> set = wave_estimate(model, m);
-        Status s = set ? Status::ok() : set.status().wrap("calibrating " + m.name);
-        // A muscle whose tissue locks before its key node reaches the
-        // table's range calibrates to a half, a quarter or an eighth of it instead
-        // (not an essential one: its range is what the FAPs rely on).
-        auto side = [&](bool maximum) {
-          Status st = calibrate_side(model, m, maximum, &cache, *set);
-          double &range = maximum ? m.range_max : m.range_min;
-          while (!st && range > 0.125 && !table[static_cast<size_t>(m.def)].essential &&
-                 st.message().find("cannot take the action") != std::string::npos) {
-            range /= 2;
-            st = calibrate_side(model, m, maximum, &cache, *set);
-          }
-          return st;
-        };
-        if (s) s = side(false);
-        if (s) s = side(true);
-        if (s) m.dynamic = std::move(*set);  // grown by both sides: V_d
-        result[k] = s;
-      } else {
-        Activation open;
-        open.jaw_open = 100;
-        jaw_pose = solve_pose(model, open, &cache);
-      }
-      cache.clear();
-      std::lock_guard<std::mutex> g(lock);
-      progress(++finished, total, what);
+    std::string what = "jaw";
+    if (k < todo.size()) {
+      Muscle &m = model.muscles[todo[k]];
+      what = m.name;
+      Expected<std::vector<int>> set = wave_estimate(model, m);
+      Status s = set ? Status::ok() : set.status().wrap("calibrating " + m.name);
+      // A muscle whose tissue locks before its key node reaches the
+      // table's range calibrates to a half, a quarter or an eighth of it instead
+      // (not an essential one: its range is what the FAPs rely on).
+      auto side = [&](bool maximum) {
+        bool locked = false;
+        Status st = calibrate_side(model, m, maximum, &cache, *set, &locked);
+        double &range = maximum ? m.range_max : m.range_min;
+        while (locked && range > 0.125 && !table[static_cast<size_t>(m.def)].essential) {
+          range /= 2;
+          st = calibrate_side(model, m, maximum, &cache, *set, &locked);
+        }
+        return st;
+      };
+      if (s) s = side(false);
+      if (s) s = side(true);
+      if (s) m.dynamic = std::move(*set);  // grown by both sides: V_d
+      result[k] = s;
+    } else {
+      Activation open;
+      open.jaw_open = 100;
+      jaw_pose = solve_pose(model, open, &cache);
     }
-  };
-  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
-  const size_t workers = std::min<size_t>(tasks, options.threads > 0 ? static_cast<size_t>(options.threads) : cores);
-  std::vector<std::thread> pool;
-  for (size_t w = 1; w < workers; ++w) pool.emplace_back(work);
-  work();
-  for (std::thread &t : pool) t.join();
+    std::lock_guard<std::mutex> g(lock);
+    progress(++finished, total, what);
+  });
 
   // In table order: a muscle that cannot reach its range is skipped, as one
   // lacking FDPs; an essential one fails the build.
@@ -310,13 +302,15 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
       model.warnings.push_back(failed[i]->message() + ": skipped");
       continue;
     }
-    for (const auto &[range, what] : {std::pair{m.range_max, "+100"}, std::pair{m.range_min, "-100"}})
-      if (range < 1)
-        model.warnings.push_back(m.name + ": its tissue locks before the key node reaches the table's " + what +
-                                 " % (" + std::to_string(std::abs(muscle_action_target(m, std::string(what) == "+100") /
-                                                                  range)) +
-                                 " model units): " + what + " % stands for " + (range == 0.5 ? "a half" : range == 0.25 ? "a quarter" : "an eighth") +
-                                 " of it");
+    for (bool maximum : {true, false}) {
+      const double range = maximum ? m.range_max : m.range_min;
+      if (range == 1) continue;
+      const std::string side = maximum ? "+100" : "-100";
+      const char *part = range == 0.5 ? "a half" : range == 0.25 ? "a quarter" : "an eighth";
+      model.warnings.push_back(m.name + ": its tissue locks before the key node reaches the table's " + side + " % (" +
+                               std::to_string(std::abs(muscle_action_target(m, maximum)) / range) +
+                               " model units): " + side + " % stands for " + part + " of it");
+    }
     kept.push_back(std::move(model.muscles[i]));
   }
   model.muscles = std::move(kept);

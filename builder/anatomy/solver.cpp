@@ -605,7 +605,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     return done(false, "solver: implicit-euler cannot solve for a tension (use a newton solver)");
   if (control && !(control->unit_load && control->action))
     return done(false, "solver: a load control needs a unit load and an action");
-  if (control) control->capped = false;
+  if (control) control->capped = control->unreachable = false;
   std::unique_ptr<FactorCache::Entry> own;
   FactorCache::Entry *entry = entry_for(model, vertices, cache, own);
   const System &sys = *entry->sys;
@@ -823,10 +823,12 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
       if (!(t_new > 0)) return done(false, name + ": the load moves the controlled action the wrong way");
       if (!std::isfinite(t_new)) return done(false, name + ": non-finite tension");
       if (t_ref == 0) t_ref = t_new;
-      if (t_new > kUnreachable * t_ref)
+      if (t_new > kUnreachable * t_ref) {
+        control->unreachable = true;
         return done(false, name + ": the load cannot take the action to " + number(control->value) +
                                " (it reached " + number(action) + " at " + number(kUnreachable) +
                                " times the linear estimate of the tension)");
+      }
       dt = t_new - t;
       t = t_new;
       dx = u + dt * w;

@@ -166,6 +166,9 @@ struct LoadControl {
   // value): one solve instead of a failed one and a second.
   double max_tension = 0;
   bool capped = false;  // out
+  // out: the solve failed because the tension passed 50 times its linear
+  // estimate before the action got there (the tissue locks first).
+  bool unreachable = false;
 };
 
 // Solves for equilibrium on `vertices` (sorted, unique skin vertex indices;

@@ -3,16 +3,14 @@
 #include <afm/mpeg4.h>
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <mutex>
 #include <optional>
-#include <thread>
 
+#include "afm/rigid_parts.h"
 #include "core/fapu.h"
-#include "anatomy/muscle_table.h"
+#include "core/parallel.h"
 #include "core/part_kind.h"
 #include "fap/fap_mapping.h"
 
@@ -59,11 +57,6 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     if (m.driver == FapDriver::Rigid || m.driver == FapDriver::None) continue;
     if (!options.only.empty() && std::find(options.only.begin(), options.only.end(), m.fap) == options.only.end())
       continue;
-    for (const std::vector<FapContraction> *g : {&m.positive, &m.negative})
-      for (const FapContraction &c : *g)
-        if (model.find(c.muscle) < 0 && find_muscle(c.muscle) < 0)
-          return Status::error(std::string("FAP synthesis: FAP ") + std::to_string(m.fap) + " names muscle '" +
-                               c.muscle + "', which the muscle table lacks");
     work.push_back({&m, +1});
     if (options.negative_sides && !m.negative.empty()) work.push_back({&m, -1});
   }
@@ -231,24 +224,14 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     o.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     res.outcome = std::move(o);
   };
-  std::atomic<size_t> next{0};
   std::mutex lock;
   int done = 0;
-  auto worker = [&] {
-    for (size_t k; (k = next++) < work.size();) {
-      make(k);
-      std::lock_guard<std::mutex> g(lock);
-      if (options.progress)
-        options.progress(++done, static_cast<int>(work.size()), fap_label(work[k].first->fap, work[k].second));
-    }
-  };
-  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
-  const size_t wanted = options.threads > 0 ? static_cast<size_t>(options.threads) : cores;
-  const size_t workers = std::min<size_t>(work.size(), wanted);
-  std::vector<std::thread> pool;
-  for (size_t w = 1; w < workers; ++w) pool.emplace_back(worker);
-  worker();
-  for (std::thread &t : pool) t.join();
+  for_each_task(work.size(), options.threads, [&](size_t k) {
+    make(k);
+    std::lock_guard<std::mutex> g(lock);
+    if (options.progress)
+      options.progress(++done, static_cast<int>(work.size()), fap_label(work[k].first->fap, work[k].second));
+  });
   for (Result &r : results) {
     if (r.target) out.targets.push_back(std::move(*r.target));
     if (r.control) out.jaw.controls.push_back(*r.control);
@@ -256,6 +239,17 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
   }
   if (out.jaw.controls.empty()) out.jaw.parts.clear();
   return out;
+}
+
+AfmContent fap_afm_content(const Scene &scene, const FdpSet &fdps, const FaceModel &model, FapSynthesis synthesis) {
+  AfmContent c;
+  c.scene = &scene;
+  c.fdps = &fdps;
+  c.fapu = model.fapu;
+  c.targets = std::move(synthesis.targets);
+  c.rigids = eye_and_head_rigids(scene, fdps, model.fapu, model.skin);
+  if (!synthesis.jaw.parts.empty()) c.rigids.push_back(std::move(synthesis.jaw));
+  return c;
 }
 
 }  // namespace afmb

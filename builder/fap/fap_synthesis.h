@@ -68,9 +68,14 @@ struct FapSynthesis {
   RigidPart jaw;                     // the jaw's rigid parts and controls (parts empty: none)
 };
 
-// Fails only on an inconsistent model (no skin, a mapping naming an unknown
-// muscle); a FAP that cannot be made is an outcome with made = false.
+// Fails only on a model without skin; a FAP that cannot be made is an
+// outcome with made = false.
 Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &model,
                                        const FapSynthesisOptions &options = {});
+
+// The AFM's content: the scene, its input FDPs (bound to `scene`; not the
+// model's estimates), the model's FAPU, the synthesis' targets, the eye and
+// head rigid parts (afm/rigid_parts.h) and the jaw's, when it has parts.
+AfmContent fap_afm_content(const Scene &scene, const FdpSet &fdps, const FaceModel &model, FapSynthesis synthesis);
 
 }  // namespace afmb

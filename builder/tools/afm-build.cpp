@@ -8,7 +8,6 @@
 #include <algorithm>
 
 #include "afm/afm_export.h"
-#include "afm/rigid_parts.h"
 #include "anatomy/face_model.h"
 #include "anatomy/muscle_table.h"
 #include "fap/fap_mapping.h"
@@ -70,6 +69,13 @@ void usage(FILE *out) {
       "Exit status: 0 on success (FAPs that cannot be made are reported, not fatal), 1\n"
       "on bad input or a solve that does not converge (the message says which and\n"
       "why), 2 on bad usage.\n");
+}
+
+// One line on stderr, rewritten in place: "[done/total] what".
+void progress_line(int done, int total, const std::string &what) {
+  std::fprintf(stderr, "\r[%3d/%3d] %-40s", done, total, what.c_str());
+  if (done == total) std::fprintf(stderr, "\n");
+  std::fflush(stderr);
 }
 
 int fail(const Status &s) {
@@ -224,12 +230,7 @@ int main(int argc, char **argv) {
   for (const std::string &line : log) std::printf("%s\n", line.c_str());
   if (!face) return fail(face.status());
 
-  if (!quiet)
-    fo.progress = [](int done, int total, const std::string &what) {
-      std::fprintf(stderr, "\r[%3d/%3d] %-40s", done, total, what.c_str());
-      if (done == total) std::fprintf(stderr, "\n");
-      std::fflush(stderr);
-    };
+  if (!quiet) fo.progress = progress_line;
   Expected<FaceModel> model = build_face_model(face->scene, face->fdps, fo);
   if (!quiet) std::fprintf(stderr, "\n");
   if (!model) return fail(model.status().wrap(mesh_path));
@@ -304,12 +305,7 @@ int main(int argc, char **argv) {
   }
   if (!out_path.empty()) {
     const auto t1 = std::chrono::steady_clock::now();
-    if (!quiet)
-      so.progress = [](int done, int total, const std::string &what) {
-        std::fprintf(stderr, "\r[%3d/%3d] %-40s", done, total, what.c_str());
-        if (done == total) std::fprintf(stderr, "\n");
-        std::fflush(stderr);
-      };
+    if (!quiet) so.progress = progress_line;
     so.threads = fo.threads;
     Expected<FapSynthesis> syn = synthesize_faps(face->scene, *model, so);
     if (!syn) return fail(syn.status());
@@ -340,13 +336,7 @@ int main(int argc, char **argv) {
                 "%.1f%% worst %.1f%%\n",
                 syn->targets.size(), failed, 100 * median(along), 100 * worst(along), 100 * median(off),
                 100 * worst(off));
-    AfmContent content;
-    content.scene = &face->scene;
-    content.fdps = &face->fdps;
-    content.fapu = model->fapu;
-    content.targets = std::move(syn->targets);
-    content.rigids = eye_and_head_rigids(face->scene, face->fdps, model->fapu, model->skin);
-    if (!syn->jaw.parts.empty()) content.rigids.push_back(syn->jaw);
+    AfmContent content = fap_afm_content(face->scene, face->fdps, *model, std::move(*syn));
     content.generator = "afm-build";
     if (Status s = write_afm(out_path, content, profile); !s) return fail(s);
     std::printf("wrote %s (%zu targets, %zu rigid parts) in %.2f s\n", out_path.c_str(), content.targets.size(),
