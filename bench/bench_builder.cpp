@@ -51,7 +51,7 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
     const double t_targets = now() - t1;
     std::vector<double> off;
     for (const FapOutcome &o : syn->outcomes)
-      if (o.made) off.push_back(o.off_axis);
+      if (o.made && o.kind == AFM_TARGET_FAP) off.push_back(o.off_axis);
     std::sort(off.begin(), off.end());
     const size_t made = syn->targets.size(), tried = syn->outcomes.size();
     Expected<std::vector<uint8_t>> bytes =

@@ -69,13 +69,20 @@ Expected<Jaw> build_jaw(const SkinModel &skin, const FdpSet &fdps, const Fapu &f
   jaw.max_open = 20.0 * 3.14159265358979323846 / 180.0;
   jaw.max_thrust = fapu.mw0 / 5;
   jaw.max_shift = fapu.mw0 / 5;
+  // The condyles glide forward as the mouth opens, so that the chin drops
+  // rather than swinging back into the throat: at 100 % the glide cancels
+  // the rotation's backward motion of 2.1.
+  const Eigen::Vector3d chin = P("2.1");
+  const Eigen::Vector3d turned = jaw.pivot + Eigen::AngleAxisd(jaw.max_open, jaw.axis) * (chin - jaw.pivot);
+  jaw.open_glide = std::max(0.0, chin.z() - turned.z());
   return jaw;
 }
 
 Eigen::Affine3d jaw_motion(const Jaw &jaw, double open_pct, double thrust_pct, double shift_pct) {
   const double angle = std::max(0.0, open_pct) / 100.0 * jaw.max_open;
   Eigen::Affine3d t = Eigen::Affine3d::Identity();
-  t.translate(thrust_pct / 100.0 * jaw.max_thrust * Eigen::Vector3d::UnitZ() +
+  t.translate((thrust_pct / 100.0 * jaw.max_thrust + std::max(0.0, open_pct) / 100.0 * jaw.open_glide) *
+                  Eigen::Vector3d::UnitZ() +
               shift_pct / 100.0 * jaw.max_shift * Eigen::Vector3d::UnitX());
   t.translate(jaw.pivot);
   t.rotate(Eigen::AngleAxisd(angle, jaw.axis));

@@ -19,9 +19,13 @@
 // Motion: rotation about the condyles' axis, +x through the pivot
 //   pivot = (0, mean of 5.3.y and 5.4.y, mean of 2.13.z and 2.14.z),
 // the cheekbones' height and the jaw corners' depth; positive angles open
-// the mouth (the chin goes down and back). 100 % opening is 20 degrees, 100 %
-// thrust is MW0 / 5 forward (+z), 100 % shift is MW0 / 5 toward the face's
-// left (+x).
+// the mouth (the chin goes down and back). 100 % opening is 20 degrees, with
+// a forward glide of the condyles in proportion (`open_glide` at 100 %: the
+// chin's backward motion at 20 degrees, so the chin drops straight down at
+// full opening, as MPEG-4's open_jaw says). 100 % thrust is MW0 / 5 forward
+// (+z), 100 % shift is MW0 / 5 toward the face's left (+x). The motion is
+//   p' = R (p - pivot) + pivot + t,  t = (shift, 0, thrust + glide),
+// as the player composes a rigid part's rotation and translation.
 #pragma once
 
 #include <Eigen/Core>
@@ -46,6 +50,7 @@ struct Jaw {
   Eigen::Vector3d axis = Eigen::Vector3d::UnitX();
   double max_open = 0;              // radians at 100 %
   double max_thrust = 0, max_shift = 0;  // model units at 100 %
+  double open_glide = 0;            // forward translation at 100 % opening, model units
   std::vector<int> dynamic;         // V_d of a full opening, sorted
 };
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <string>
 
 namespace afmb {
 
@@ -96,7 +97,82 @@ std::vector<FapMapping> make_table() {
   return t;
 }
 
+// Visemes and expressions. Muscles by pair name ("zygomaticus_major" is
+// both sides); the signs as above: a negative upper lip raises the upper
+// lip, a negative orbicularis oculi widens the eye. Jaw openings in FAP 3
+// units (the table's reference, wide open, is 320). Mentalis stays at a
+// few percent: its calibrated range is its key node's alone (8 % of its
+// fibre), and both sides together lift the free lower lip several times
+// further (FAP 5 needs 6 % of both for 350 units on the 2k head).
+std::vector<HighLevelMapping> make_high_level_table() {
+  std::vector<HighLevelMapping> t;
+  struct Pair {
+    const char *muscle;  // a pair name (both sides) or a single muscle's
+    double percent;
+  };
+  auto add = [&](bool expression, int number, int jaw, std::vector<Pair> pairs, const char *note) {
+    HighLevelMapping m;
+    m.expression = expression;
+    m.number = number;
+    m.jaw_open = jaw;
+    m.note = note;
+    for (const Pair &p : pairs) {
+      const std::string name = p.muscle;
+      if (name == "orbicularis_oris") m.muscles.push_back({name, p.percent});
+      else
+        for (const char *side : {"_left", "_right"}) m.muscles.push_back({name + side, p.percent});
+    }
+    t.push_back(std::move(m));
+  };
+  // ---- visemes (ISO/IEC 14496-2 Table C-1) ----
+  add(false, 1, 0, {{"orbicularis_oris", 50}, {"mentalis", 5}}, "lips pressed together");
+  add(false, 2, 60, {{"mentalis", 6}, {"upper_lip", -30}}, "lower lip up against the upper teeth");
+  add(false, 3, 100, {}, "jaw a little open, tongue between the teeth");
+  add(false, 4, 90, {}, "jaw a little open");
+  add(false, 5, 130, {}, "jaw half open");
+  add(false, 6, 80, {{"orbicularis_oris", 60}, {"upper_lip", -20}}, "lips rounded and pushed out");
+  add(false, 7, 50, {{"risorius", 50}}, "teeth near, lips spread");
+  add(false, 8, 100, {}, "jaw a little open");
+  add(false, 9, 90, {{"orbicularis_oris", 40}}, "lips a little rounded");
+  add(false, 10, 300, {}, "jaw wide open");
+  add(false, 11, 180, {{"risorius", 50}, {"zygomaticus_major", 20}}, "jaw open, lips spread");
+  add(false, 12, 100, {{"risorius", 70}, {"zygomaticus_major", 30}}, "lips spread wide");
+  add(false, 13, 250, {{"orbicularis_oris", 40}}, "jaw open, lips rounded");
+  add(false, 14, 90, {{"orbicularis_oris", 90}}, "lips tightly rounded and pushed out");
+  // ---- expressions (ISO/IEC 14496-2 Table C-3) ----
+  add(true, 1, 40,
+      {{"zygomaticus_major", 100}, {"zygomaticus_minor", 50}, {"risorius", 20}, {"orbicularis_oculi", 40}},
+      "joy: corners up and back, cheeks raised, eyes narrowed");
+  add(true, 2, 0,
+      {{"frontalis_inner", 80}, {"corrugator", 50}, {"depressor_anguli", 100}, {"mentalis", 4}},
+      "sadness: inner brows up and together, corners down, chin raised");
+  add(true, 3, 0, {{"corrugator", 100}, {"orbicularis_oculi", 40}, {"orbicularis_oris", 50}, {"mentalis", 3}},
+      "anger: brows down and together, eyes narrowed, lips pressed");
+  add(true, 4, 80,
+      {{"frontalis_inner", 100}, {"frontalis_major", 50}, {"corrugator", 40}, {"risorius", 70},
+       {"orbicularis_oculi", -50}},
+      "fear: brows up and together, eyes wide, lips stretched, jaw dropped");
+  add(true, 5, 0,
+      {{"upper_lip", -100}, {"nasalis", 60}, {"corrugator", 40}, {"depressor_anguli", 30}, {"mentalis", 5}},
+      "disgust: upper lip raised, nose wrinkled, brows lowered");
+  add(true, 6, 220,
+      {{"frontalis_inner", 100}, {"frontalis_major", 100}, {"frontalis_outer", 100}, {"orbicularis_oculi", -60}},
+      "surprise: brows raised, eyes wide, jaw dropped");
+  return t;
+}
+
 }  // namespace
+
+const std::vector<HighLevelMapping> &high_level_mappings() {
+  static const std::vector<HighLevelMapping> table = make_high_level_table();
+  return table;
+}
+
+const HighLevelMapping *find_high_level_mapping(bool expression, int number) {
+  for (const HighLevelMapping &m : high_level_mappings())
+    if (m.expression == expression && m.number == number) return &m;
+  return nullptr;
+}
 
 const std::vector<FapMapping> &fap_mappings() {
   static const std::vector<FapMapping> table = make_table();
@@ -127,7 +203,7 @@ std::string fap_mapping_text() {
     std::string s;
     for (const FapContraction &c : g) {
       char b[96];
-      std::snprintf(b, sizeof b, "%s%s %+g%%", s.empty() ? "" : ", ", c.muscle, c.percent);
+      std::snprintf(b, sizeof b, "%s%s %+g%%", s.empty() ? "" : ", ", c.muscle.c_str(), c.percent);
       s += b;
     }
     return s;
@@ -142,6 +218,15 @@ std::string fap_mapping_text() {
     if (!m.negative.empty()) out += "  - " + group(m.negative);
     if (m.note && *m.note) out += std::string("  (") + m.note + ")";
     out += "\n";
+  }
+  for (const HighLevelMapping &m : high_level_mappings()) {
+    char head[128];
+    std::snprintf(head, sizeof head, "%s%-2d %-22s %-10s ref 63", m.expression ? "e" : "v", m.number,
+                  m.expression ? afm_expression_name(m.number) : afm_viseme_phonemes(m.number), "muscles");
+    out += head;
+    if (m.jaw_open) out += "  jaw " + std::to_string(m.jaw_open);
+    if (!m.muscles.empty()) out += "  + " + group(m.muscles);
+    out += std::string("  (") + m.note + ")\n";
   }
   return out;
 }

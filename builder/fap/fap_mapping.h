@@ -30,7 +30,7 @@ enum class FapDriver {
 };
 
 struct FapContraction {
-  const char *muscle;   // FaceModel muscle name
+  std::string muscle;   // FaceModel muscle name
   double percent;       // contraction at scale 1, -100..100
 };
 
@@ -54,7 +54,28 @@ const FapMapping *find_fap_mapping(int fap);
 // "muscles", "jaw-open", "jaw-thrust", "jaw-shift", "rigid", "none".
 const char *fap_driver_name(FapDriver driver);
 
-// The table as text, one FAP per line (afm-build --list-faps).
+// The 14 visemes and 6 expressions (FAP 1 and 2): each a fixed muscle
+// combination and jaw opening, posed once; the pose is the target, stored
+// at reference 63 (the top of viseme_blend and expression_intensity). No
+// FDP rule applies to them, so nothing is steered: the table's numbers are
+// the face at full intensity.
+struct HighLevelMapping {
+  bool expression = false;                  // false: viseme
+  int number = 0;                           // viseme 1..14, expression 1..6
+  std::vector<FapContraction> muscles;      // percent of each muscle's calibrated range
+  int jaw_open = 0;                         // FAP 3 (open_jaw) units, MNS/1024: how far the chin drops
+  const char *note = "";                    // what the face does
+};
+
+// The 14 visemes, then the 6 expressions, in number order.
+const std::vector<HighLevelMapping> &high_level_mappings();
+
+// The mapping of viseme (expression = false) or expression `number`, or
+// nullptr when out of range.
+const HighLevelMapping *find_high_level_mapping(bool expression, int number);
+
+// Both tables as text, one FAP, viseme or expression per line (afm-build
+// --list-faps).
 std::string fap_mapping_text();
 
 }  // namespace afmb

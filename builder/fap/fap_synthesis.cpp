@@ -44,6 +44,11 @@ std::string fap_label(int fap, int side) {
   return std::string(info ? info->name : "fap") + (side < 0 ? " (negative)" : "");
 }
 
+std::string high_level_label(const HighLevelMapping &h) {
+  return h.expression ? std::string(afm_expression_name(h.number))
+                      : "viseme " + std::string(afm_viseme_phonemes(h.number));
+}
+
 }  // namespace
 
 Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &model, const FapSynthesisOptions &options) {
@@ -51,15 +56,27 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
   const SkinModel &skin = model.tissue;
   FapSynthesis out;
 
-  // The work list: (mapping, side).
-  std::vector<std::pair<const FapMapping *, int>> work;
+  // The work list: a FAP's mapping and side, or a viseme's or an
+  // expression's.
+  struct Work {
+    const FapMapping *fap = nullptr;
+    const HighLevelMapping *high = nullptr;
+    int side = +1;
+  };
+  auto listed = [](const std::vector<int> &list, int n) {
+    return std::find(list.begin(), list.end(), n) != list.end();
+  };
+  const bool everything = options.only.empty() && options.only_visemes.empty() && options.only_expressions.empty();
+  std::vector<Work> work;
   for (const FapMapping &m : fap_mappings()) {
     if (m.driver == FapDriver::Rigid || m.driver == FapDriver::None) continue;
-    if (!options.only.empty() && std::find(options.only.begin(), options.only.end(), m.fap) == options.only.end())
-      continue;
-    work.push_back({&m, +1});
-    if (options.negative_sides && !m.negative.empty()) work.push_back({&m, -1});
+    if (!everything && !listed(options.only, m.fap)) continue;
+    work.push_back({&m, nullptr, +1});
+    if (options.negative_sides && !m.negative.empty()) work.push_back({&m, nullptr, -1});
   }
+  for (const HighLevelMapping &h : high_level_mappings())
+    if (everything || listed(h.expression ? options.only_expressions : options.only_visemes, h.number))
+      work.push_back({nullptr, &h, +1});
 
   out.jaw.kind = AFM_RIGID_JAW;
   out.jaw.pivot = model.jaw.pivot;
@@ -72,17 +89,83 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
   struct Result {
     FapOutcome outcome;
     std::optional<MorphTarget> target;
-    std::optional<RigidPart::Control> control;
+    std::optional<RigidPart::Control> control, glide;
   };
   std::vector<Result> results(work.size());
+  // A viseme or an expression: the table's pose, once.
+  auto make_high_level = [&](const HighLevelMapping &h, Result &res) {
+    const auto start = std::chrono::steady_clock::now();
+    FapOutcome o;
+    o.kind = h.expression ? AFM_TARGET_EXPRESSION : AFM_TARGET_VISEME;
+    o.number = h.number;
+    o.reference = 63;
+    Activation a;
+    std::string missing;
+    for (const FapContraction &c : h.muscles) {
+      const int i = model.find(c.muscle);
+      const Muscle *mu = i < 0 ? nullptr : &model.muscles[static_cast<size_t>(i)];
+      if (!mu || !(c.percent > 0 ? mu->tension_max > 0 : mu->tension_min > 0))
+        missing += (missing.empty() ? "" : ", ") + c.muscle;
+      else
+        a.muscles.push_back({i, c.percent});
+    }
+    if (!missing.empty()) o.message = "without " + missing + ": not in the model or not calibrated";
+    Eigen::Affine3d jaw = Eigen::Affine3d::Identity();
+    if (h.jaw_open > 0) {
+      // The chin (2.1) drops by jaw_open FAP 3 units, as the bone carries it.
+      const afm_fap_info *info = afm_fap(3);
+      const FdpPoint *chin = model.fdps.find(FdpId{info->fdp_group, info->fdp_index}, model.skin);
+      if (model.jaw.vertices.empty() || !chin || chin->vertex < 0) {
+        o.message += std::string(o.message.empty() ? "" : "; ") + "without the jaw: the model has none";
+      } else {
+        const double unit = fapu_distance(model.fapu, info->unit) / 1024.0;
+        a.jaw_open = jaw_percent(model.jaw, FapDriver::JawOpen, skin.X0.row(chin->vertex).transpose(),
+                                 fap_direction(info), h.jaw_open * unit);
+        jaw = jaw_motion(model.jaw, a.jaw_open, 0, 0);
+      }
+    }
+    if (a.muscles.empty() && a.jaw_open == 0) {
+      o.message = "nothing to pose: " + o.message;
+    } else {
+      FactorCache cache;
+      Expected<Pose> pose = solve_pose(model, a, &cache);
+      if (!pose) {
+        o.message = pose.status().message();
+      } else {
+        const Eigen::MatrixXd D = pose_epidermis(model, *pose) - skin.X0.topRows(skin.n);
+        o.made = true;
+        o.largest = D.rowwise().norm().maxCoeff();
+        o.dynamic = static_cast<int>(pose->dynamic.size());
+        o.scale = 1;
+        MorphTarget t;
+        t.kind = o.kind;
+        t.number = h.number;
+        t.reference = 63;
+        t.displacement.assign(scene.parts.size(), Eigen::MatrixXd());
+        t.displacement[static_cast<size_t>(model.skin)] = D;
+        // No rigid control serves FAP 1 or 2: the jaw's parts move in the
+        // target itself.
+        if (!jaw.matrix().isIdentity(0))
+          for (int p : out.jaw.parts) {
+            const Eigen::MatrixXd &V = scene.parts[static_cast<size_t>(p)].V;
+            t.displacement[static_cast<size_t>(p)] =
+                (V * jaw.linear().transpose()).rowwise() + jaw.translation().transpose() - V;
+          }
+        res.target = std::move(t);
+      }
+    }
+    o.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    res.outcome = std::move(o);
+  };
   auto make = [&](size_t k) {
-    const FapMapping *map = work[k].first;
-    const int side = work[k].second;
     Result &res = results[k];
+    if (work[k].high) return make_high_level(*work[k].high, res);
+    const FapMapping *map = work[k].fap;
+    const int side = work[k].side;
     const auto start = std::chrono::steady_clock::now();
     const afm_fap_info *info = afm_fap(map->fap);
     FapOutcome o;
-    o.fap = map->fap;
+    o.number = map->fap;
     o.side = side;
     o.reference = side * map->reference;
     const Eigen::Vector3d dir = fap_direction(info);
@@ -134,6 +217,12 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
           if (map->driver == FapDriver::JawOpen) {
             c.dof = AFM_DOF_ROTATE_X;
             c.gain = pct / 100.0 * model.jaw.max_open / map->reference / 1e-5;  // AU per FAP unit
+            // The condyles' glide (jaw.h): a second control on the same FAP.
+            RigidPart::Control glide;
+            glide.fap = map->fap;
+            glide.dof = AFM_DOF_TRANSLATE_Z;
+            glide.gain = pct / 100.0 * model.jaw.open_glide / map->reference;
+            if (side > 0 && glide.gain > 0) res.glide = glide;
           } else if (map->driver == FapDriver::JawThrust) {
             c.dof = AFM_DOF_TRANSLATE_Z;
             c.gain = pct / 100.0 * model.jaw.max_thrust / map->reference;
@@ -149,7 +238,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       std::string missing;
       for (const FapContraction &c : side > 0 ? map->positive : map->negative) {
         const int i = model.find(c.muscle);
-        if (i < 0) missing += (missing.empty() ? "" : ", ") + std::string(c.muscle);
+        if (i < 0) missing += (missing.empty() ? "" : ", ") + c.muscle;
         else pattern.push_back({i, c.percent});
       }
       if (!missing.empty()) {
@@ -230,11 +319,13 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     make(k);
     std::lock_guard<std::mutex> g(lock);
     if (options.progress)
-      options.progress(++done, static_cast<int>(work.size()), fap_label(work[k].first->fap, work[k].second));
+      options.progress(++done, static_cast<int>(work.size()),
+                       work[k].high ? high_level_label(*work[k].high) : fap_label(work[k].fap->fap, work[k].side));
   });
   for (Result &r : results) {
     if (r.target) out.targets.push_back(std::move(*r.target));
     if (r.control) out.jaw.controls.push_back(*r.control);
+    if (r.glide) out.jaw.controls.push_back(*r.glide);
     out.outcomes.push_back(std::move(r.outcome));
   }
   if (out.jaw.controls.empty()) out.jaw.parts.clear();

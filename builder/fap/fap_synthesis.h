@@ -10,6 +10,11 @@
 // the same rule, then solve the tissue around it; the jaw's rigid parts
 // (lower teeth, tongue) get a control with the same motion.
 //
+// Visemes and expressions (fap_mapping.h, HighLevelMapping): the table's
+// muscles and jaw opening posed once; the target holds the skin and, when
+// the jaw opens, the jaw's rigid parts carried by it (these targets have no
+// rigid control).
+//
 // The scale stays within the muscles' calibrated range (s <= 1 with the
 // table's contractions at 100 %). A group that cannot reach the reference
 // there makes its target at s = 1, and the reference becomes what it reaches
@@ -36,9 +41,10 @@
 namespace afmb {
 
 struct FapOutcome {
-  int fap = 0;
+  afm_target_kind kind = AFM_TARGET_FAP;
+  int number = 0;                 // FAP 3..68, viseme 1..14 or expression 1..6, after `kind`
   int side = +1;                  // +1: the positive reference, -1: the negative one
-  int reference = 0;              // signed FAP units
+  int reference = 0;              // signed FAP units (63 for visemes and expressions)
   bool made = false;              // a target was made
   std::string message;            // why not, when !made; why the reference was lowered
   int lowered_from = 0;           // the table's reference when the group could not reach it
@@ -47,13 +53,20 @@ struct FapOutcome {
   Eigen::Vector3d achieved = Eigen::Vector3d::Zero();
   double along_error = 0;         // |achieved . dir - prescribed . dir| / |prescribed|
   double off_axis = 0;            // |achieved - (achieved . dir) dir| / |prescribed|
+  // Visemes and expressions have no FDP rule: prescribed, achieved and the
+  // errors stay zero; `largest` says how far the face moved.
+  double largest = 0;             // the largest skin vertex displacement, model units
   double scale = 0;               // muscle groups: the factor on the table's contractions
   int dynamic = 0;                // vertices solved
   double seconds = 0;
 };
 
 struct FapSynthesisOptions {
-  std::vector<int> only;          // FAP numbers to make (empty: every mapped one)
+  // What to make. All three empty: every mapped FAP, viseme and expression;
+  // otherwise only those listed.
+  std::vector<int> only;          // FAP numbers
+  std::vector<int> only_visemes;  // 1..14
+  std::vector<int> only_expressions;  // 1..6
   bool negative_sides = true;     // make the negative side's own target where the table has one
   // Workers (0: one per core). The targets are the same for any number.
   int threads = 0;
@@ -63,7 +76,9 @@ struct FapSynthesisOptions {
 };
 
 struct FapSynthesis {
-  std::vector<MorphTarget> targets;  // the made ones, in FAP order, positive side first
+  // The made ones: FAPs in number order (positive side first), then the
+  // visemes, then the expressions.
+  std::vector<MorphTarget> targets;
   std::vector<FapOutcome> outcomes;  // every attempted one, in the same order
   RigidPart jaw;                     // the jaw's rigid parts and controls (parts empty: none)
 };

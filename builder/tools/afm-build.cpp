@@ -12,6 +12,7 @@
 #include "anatomy/muscle_table.h"
 #include "fap/fap_mapping.h"
 #include "fap/fap_synthesis.h"
+#include "fap/fidelity_report.h"
 #include "io/load_face.h"
 #include "render/anatomy_render.h"
 
@@ -56,12 +57,19 @@ void usage(FILE *out) {
       "                          (repeatable; positive is the muscle's action)\n"
       "  --jaw PCT               open the jaw, 0..100 %% (100 %% is 20 degrees)\n"
       "  --pose FILE.png         solve the pose given by --contract/--jaw and draw it\n"
-      "  -o FACE.afm             synthesize the FAP morph targets and write the AFM;\n"
-      "                          prints, per target, the prescribed and achieved FDP\n"
-      "                          motion and the error along and off the FAP's direction\n"
+      "  -o FACE.afm             synthesize the morph targets (each FAP, viseme and\n"
+      "                          expression) and write the AFM; prints, per target, the\n"
+      "                          prescribed and achieved FDP motion and the error along\n"
+      "                          and off the FAP's direction\n"
       "  --profile P             draco (default: compressed) or raw\n"
-      "  --faps LIST             only these FAPs, e.g. 3,12,31 (default: every mapped one)\n"
-      "  --list-faps             how each FAP is made: muscles, jaw, rigid or not at all\n"
+      "  --faps LIST             only these targets: FAP numbers, vN visemes, eN\n"
+      "                          expressions, e.g. 3,12,31,v1,e1 (default: every mapped one)\n"
+      "  --report DIR            with -o, also write the fidelity report into DIR:\n"
+      "                          report.txt, report.csv, a picture per target\n"
+      "                          (targets/*.png), a contact sheet (sheet.png) and\n"
+      "                          index.html showing them together\n"
+      "  --list-faps             how each FAP, viseme and expression is made: muscles,\n"
+      "                          jaw, rigid or not at all\n"
       "  --list-muscles          the 25 muscles and their key points\n"
       "  -q, --quiet             no progress lines\n"
       "  --help                  this text\n"
@@ -98,7 +106,7 @@ int main(int argc, char **argv) {
   LoadOptions lo;
   FaceModelOptions fo;
   bool quiet = false, list = false, list_faps = false;
-  std::string out_path;
+  std::string out_path, report_dir;
   afm_profile profile = AFM_PROFILE_DRACO;
   FapSynthesisOptions so;
   for (int i = 1; i < argc; ++i) {
@@ -176,15 +184,26 @@ int main(int argc, char **argv) {
       while (at <= l.size()) {
         const size_t comma = std::min(l.find(',', at), l.size());
         const std::string item = l.substr(at, comma - at);
+        const bool high = !item.empty() && (item[0] == 'v' || item[0] == 'e');
         char *end = nullptr;
-        const long n = std::strtol(item.c_str(), &end, 10);
-        const FapMapping *m = item.empty() || *end ? nullptr : find_fap_mapping(static_cast<int>(n));
+        const long n = std::strtol(item.c_str() + (high ? 1 : 0), &end, 10);
+        const bool number = item.size() > (high ? 1u : 0u) && !*end;
+        if (high) {
+          if (!number || !find_high_level_mapping(item[0] == 'e', static_cast<int>(n)))
+            return usage_error("--faps '" + l + "': '" + item + "' is not a viseme v1..v14 or an expression e1..e6");
+          (item[0] == 'e' ? so.only_expressions : so.only_visemes).push_back(static_cast<int>(n));
+          at = comma + 1;
+          continue;
+        }
+        const FapMapping *m = number ? find_fap_mapping(static_cast<int>(n)) : nullptr;
         if (!m) return usage_error("--faps '" + l + "': '" + item + "' is not a FAP number 3..68");
         if (m->driver == FapDriver::Rigid || m->driver == FapDriver::None)
           return usage_error("--faps: FAP " + item + " has no morph target (--list-faps)");
         so.only.push_back(static_cast<int>(n));
         at = comma + 1;
       }
+    } else if (a == "--report") {
+      report_dir = value("--report");
     } else if (a == "--list-faps") {
       list_faps = true;
     } else if (a == "-q" || a == "--quiet") {
@@ -223,6 +242,7 @@ int main(int argc, char **argv) {
     if (find_muscle(inf.first) < 0) return usage_error("--influence: no muscle '" + inf.first + "' (--list-muscles)");
   if (!pose_png.empty() && !fo.calibrate) return usage_error("--pose needs calibrated muscles (drop --no-calibrate)");
   if (!out_path.empty() && !fo.calibrate) return usage_error("-o needs calibrated muscles (drop --no-calibrate)");
+  if (!report_dir.empty() && out_path.empty()) return usage_error("--report needs -o");
 
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<std::string> log;
@@ -309,33 +329,14 @@ int main(int argc, char **argv) {
     so.threads = fo.threads;
     Expected<FapSynthesis> syn = synthesize_faps(face->scene, *model, so);
     if (!syn) return fail(syn.status());
-    std::printf("%-4s %-24s %6s %8s %10s %10s %8s %8s %7s\n", "fap", "name", "ref", "scale", "prescribed",
-                "achieved", "along", "off-axis", "V_d");
-    std::vector<double> along, off;
-    int failed = 0;
-    for (const FapOutcome &o : syn->outcomes) {
-      const afm_fap_info *info = afm_fap(o.fap);
-      if (!o.made) {
-        ++failed;
-        std::printf("%-4d %-24s %6d  not made: %s\n", o.fap, info->name, o.reference, o.message.c_str());
-        continue;
-      }
-      along.push_back(o.along_error);
-      off.push_back(o.off_axis);
-      std::printf("%-4d %-24s %6d %8.3f %10.4g %10.4g %7.2f%% %7.1f%% %7d%s%s\n", o.fap, info->name, o.reference,
-                  o.scale, o.prescribed.norm(), o.achieved.norm(), 100 * o.along_error, 100 * o.off_axis, o.dynamic,
-                  o.lowered_from ? "  " : "", o.lowered_from ? o.message.c_str() : "");
+    std::printf("%s", fidelity_table(*syn).c_str());
+    if (!report_dir.empty()) {
+      FidelityReportOptions ro;
+      if (!quiet) ro.progress = progress_line;
+      if (Status st = write_fidelity_report(report_dir, face->scene, *model, *syn, ro); !st) return fail(st);
+      std::printf("wrote the fidelity report into %s/ (index.html, sheet.png, report.txt, report.csv)\n",
+                  report_dir.c_str());
     }
-    auto median = [](std::vector<double> v) {
-      if (v.empty()) return 0.0;
-      std::sort(v.begin(), v.end());
-      return v[v.size() / 2];
-    };
-    auto worst = [](const std::vector<double> &v) { return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end()); };
-    std::printf("targets: %zu made, %d not made; along the direction median %.2f%% worst %.2f%%; off-axis median "
-                "%.1f%% worst %.1f%%\n",
-                syn->targets.size(), failed, 100 * median(along), 100 * worst(along), 100 * median(off),
-                100 * worst(off));
     AfmContent content = fap_afm_content(face->scene, face->fdps, *model, std::move(*syn));
     content.generator = "afm-build";
     if (Status s = write_afm(out_path, content, profile); !s) return fail(s);

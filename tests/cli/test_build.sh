@@ -14,17 +14,35 @@ bin="$bin/afm-build"
 
 "$bin" --list-faps | grep -q "^ 3 open_jaw  *jaw-open" || fail "--list-faps lacks open_jaw"
 [ "$("$bin" --list-faps | grep -c '^ *[0-9]')" -eq 66 ] || fail "--list-faps does not list FAPs 3..68"
+[ "$("$bin" --list-faps | grep -c '^v[0-9]')" -eq 14 ] || fail "--list-faps does not list the 14 visemes"
+[ "$("$bin" --list-faps | grep -c '^e[0-9]')" -eq 6 ] || fail "--list-faps does not list the 6 expressions"
 
 "$gen" --vertices 1000 -o "$tmp/h.wrl" >/dev/null 2>&1 || fail "afm-headgen failed"
 
-# An AFM with two FAPs: the report, then the file as afm-info reads it.
-"$bin" "$tmp/h.wrl" "$tmp/h.fdp" -q --faps 3,12 --profile raw -o "$tmp/h.afm" >"$tmp/afm.txt" 2>&1 ||
-  fail "an AFM build failed: $(cat "$tmp/afm.txt")"
+# An AFM with two FAPs, a viseme and an expression: the report, the
+# fidelity report's files, then the AFM as afm-info reads it.
+"$bin" "$tmp/h.wrl" "$tmp/h.fdp" -q --faps 3,12,v10,e1 --profile raw -o "$tmp/h.afm" --report "$tmp/report" \
+  >"$tmp/afm.txt" 2>&1 || fail "an AFM build failed: $(cat "$tmp/afm.txt")"
 grep -q "^3  *open_jaw  *320 " "$tmp/afm.txt" || fail "no report line for open_jaw: $(cat "$tmp/afm.txt")"
-grep -q "^12  *raise_l_cornerlip  *-" "$tmp/afm.txt" || fail "no negative side for raise_l_cornerlip"
-grep -q "^targets: 3 made, 0 not made" "$tmp/afm.txt" || fail "no summary: $(cat "$tmp/afm.txt")"
+grep -q "^12  *raise_l_cornerlip (negative)  *-150 " "$tmp/afm.txt" || fail "no negative side for raise_l_cornerlip"
+grep -q "^v10  *viseme A:  *63 " "$tmp/afm.txt" || fail "no report line for viseme A:"
+grep -q "^e1  *joy  *63 " "$tmp/afm.txt" || fail "no report line for joy"
+grep -q "^targets: 5 made, 0 not made" "$tmp/afm.txt" || fail "no summary: $(cat "$tmp/afm.txt")"
+r="$tmp/report"
+[ "$(grep -c -x -F -f "$r/report.txt" "$tmp/afm.txt")" -eq "$(wc -l <"$r/report.txt")" ] &&
+  [ "$(wc -l <"$r/report.txt")" -eq 7 ] || fail "report.txt is not the printed table: $(cat "$r/report.txt")"
+[ "$(grep -c '^[a-z]*,' "$r/report.csv")" -eq 6 ] || fail "report.csv: not a header and 5 rows: $(cat "$r/report.csv")"
+grep -q '^viseme,10,"viseme A:",1,63,0,1,' "$r/report.csv" || fail "report.csv: no viseme A: row"
+# The contact sheet: neutral and 5 targets of 240 x 288 in one row, 4-pixel gaps.
+for t in neutral fap03 fap12 fap12-neg viseme10 expression1; do
+  [ -s "$r/targets/$t.png" ] || fail "no picture targets/$t.png"
+  grep -q "targets/$t.png" "$r/index.html" || fail "index.html does not show targets/$t.png"
+done
+size=$(od -An -tu1 -j16 -N8 "$r/sheet.png" | awk '{ printf "%dx%d", $3 * 256 + $4, $7 * 256 + $8 }')
+[ "$size" = "1468x296" ] || fail "sheet.png is $size, not 6 tiles of 240x288 in a row (1468x296)"
 "$info" --targets "$tmp/h.afm" >"$tmp/info.txt" 2>&1 || fail "afm-info cannot read the AFM"
 grep -q "FAP  *3  *open_jaw  *320" "$tmp/info.txt" || fail "afm-info lists no open_jaw target: $(cat "$tmp/info.txt")"
+grep -qi "viseme  *10 " "$tmp/info.txt" || fail "afm-info lists no viseme 10: $(cat "$tmp/info.txt")"
 
 # Placement only: the summary and three pictures.
 "$bin" "$tmp/h.wrl" "$tmp/h.fdp" --no-calibrate -q --muscle-map "$tmp/map.png" \
@@ -51,6 +69,8 @@ expect_error "pose without calibration" 2 "needs calibrated" "$tmp/bad.png" -- \
 expect_error "AFM without calibration" 2 "needs calibrated" "$tmp/bad.afm" -- \
   "$bin" "$h" "$f" --no-calibrate -o "$tmp/bad.afm"
 expect_error "bad FAP list" 2 "not a FAP number" "$tmp/bad.afm" -- "$bin" "$h" "$f" --faps 3,x -o "$tmp/bad.afm"
+expect_error "bad viseme" 2 "not a viseme v1..v14" "$tmp/bad.afm" -- "$bin" "$h" "$f" --faps v15 -o "$tmp/bad.afm"
+expect_error "report without -o" 2 "--report needs -o" "$tmp/r" -- "$bin" "$h" "$f" --report "$tmp/r"
 expect_error "FAP without target" 2 "has no morph target" "$tmp/bad.afm" -- "$bin" "$h" "$f" --faps 48 -o "$tmp/bad.afm"
 expect_error "bad profile" 2 "use draco or raw" "$tmp/bad.afm" -- "$bin" "$h" "$f" --profile zip -o "$tmp/bad.afm"
 

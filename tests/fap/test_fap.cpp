@@ -16,6 +16,8 @@
 #include "anatomy/face_model.h"
 #include "anatomy/muscle_table.h"
 #include "anatomy/muscles.h"
+#include "anatomy/solver.h"
+#include "core/part_kind.h"
 #include "core/fapu.h"
 #include "fap/fap_mapping.h"
 #include "fap/fap_synthesis.h"
@@ -63,6 +65,36 @@ TEST(FapMapping, CoversEveryLowLevelFapOnceAndAgreesWithTheMpeg4Table) {
   EXPECT_NE(fap_mapping_text().find("open_jaw"), std::string::npos);
 }
 
+TEST(FapMapping, FourteenVisemesAndSixExpressionsEachOnceFromRealMuscles) {
+  const std::vector<HighLevelMapping> &t = high_level_mappings();
+  ASSERT_EQ(t.size(), 20u);
+  for (size_t i = 0; i < t.size(); ++i) {
+    const HighLevelMapping &m = t[i];
+    // Visemes 1..14 first, then expressions 1..6 (MPEG-4 numbering).
+    EXPECT_EQ(m.expression, i >= 14);
+    EXPECT_EQ(m.number, static_cast<int>(m.expression ? i - 13 : i + 1));
+    EXPECT_EQ(find_high_level_mapping(m.expression, m.number), &m);
+    EXPECT_STRNE(m.note, "");
+    // The jaw within what FAP 3's target covers; something moves.
+    EXPECT_TRUE(m.jaw_open >= 0 && m.jaw_open <= find_fap_mapping(3)->reference) << m.number;
+    EXPECT_TRUE(m.jaw_open > 0 || !m.muscles.empty()) << m.number;
+    for (const FapContraction &c : m.muscles) {
+      EXPECT_GE(find_muscle(c.muscle), 0) << c.muscle;
+      EXPECT_TRUE(c.percent >= -100 && c.percent <= 100 && c.percent != 0) << c.muscle << " " << c.percent;
+    }
+  }
+  EXPECT_EQ(find_high_level_mapping(false, 15), nullptr);
+  EXPECT_EQ(find_high_level_mapping(true, 0), nullptr);
+  // Joy is the zygomatic smile (FACS AU 12); sadness pulls the corners down (AU 15).
+  auto uses = [](const HighLevelMapping *m, const char *muscle) {
+    for (const FapContraction &c : m->muscles)
+      if (c.muscle == muscle && c.percent > 0) return true;
+    return false;
+  };
+  EXPECT_TRUE(uses(find_high_level_mapping(true, 1), "zygomaticus_major_left"));
+  EXPECT_TRUE(uses(find_high_level_mapping(true, 2), "depressor_anguli_right"));
+}
+
 using Built = afmtest::ReferenceModel;
 
 // The 1,000-vertex reference head, calibrated for the muscles the tests use.
@@ -81,6 +113,8 @@ const FapSynthesis &synthesis() {
   if (!s) {
     FapSynthesisOptions o;
     o.only = {3, 12, 33};
+    o.only_visemes = {10};          // A: the jaw only
+    o.only_expressions = {1, 2};    // joy and sadness: the corner up and down
     Expected<FapSynthesis> r = synthesize_faps(head_1k().head.scene, head_1k().model, o);
     EXPECT_TRUE(r.is_ok()) << r.status().message();
     s = std::make_unique<FapSynthesis>(std::move(*r));
@@ -88,22 +122,53 @@ const FapSynthesis &synthesis() {
   return *s;
 }
 
-// The skin displacement of FAP `fap`'s target on side `side`, or nullptr.
+// FAP `fap`'s target on side `side`, or nullptr.
 const MorphTarget *target(int fap, int side) {
   for (const MorphTarget &t : synthesis().targets)
-    if (t.number == fap && (t.reference > 0) == (side > 0)) return &t;
+    if (t.kind == AFM_TARGET_FAP && t.number == fap && (t.reference > 0) == (side > 0)) return &t;
   return nullptr;
+}
+
+// A viseme's or an expression's target, or nullptr.
+const MorphTarget *high_level_target(afm_target_kind kind, int number) {
+  for (const MorphTarget &t : synthesis().targets)
+    if (t.kind == kind && t.number == number) return &t;
+  return nullptr;
+}
+
+// The outcome of a viseme or an expression, or nullptr.
+const FapOutcome *high_level_outcome(afm_target_kind kind, int number) {
+  for (const FapOutcome &o : synthesis().outcomes)
+    if (o.kind == kind && o.number == number) return &o;
+  return nullptr;
+}
+
+// The skin displacement of target t at FDP `group.index`.
+Eigen::Vector3d at_fdp(const MorphTarget &t, int group, int index) {
+  const FaceModel &m = head_1k().model;
+  const FdpPoint *p = m.fdps.find(FdpId{group, index}, m.skin);
+  EXPECT_TRUE(p && p->part == m.skin) << group << "." << index;
+  if (!p) return Eigen::Vector3d::Zero();
+  return t.displacement[static_cast<size_t>(m.skin)].row(p->vertex).transpose();
+}
+
+// The MPEG-4 direction of FAP `fap` (x: the face's left, y: up, z: forward).
+Eigen::Vector3d direction_of(int fap) {
+  const afm_fap_info *info = afm_fap(fap);
+  return Eigen::Vector3d(info->direction[0], info->direction[1], info->direction[2]);
 }
 
 TEST(FapSynthesis, EachTargetMovesItsFdpByReferenceTimesFapuAlongTheFapsDirection) {
   const FaceModel &m = head_1k().model;
   const FapSynthesis &s = synthesis();
-  // 3 (positive only), 12 and 33 (both sides).
-  ASSERT_EQ(s.outcomes.size(), 5u);
+  // 3 (positive only), 12 and 33 (both sides), then a viseme and two
+  // expressions.
+  ASSERT_EQ(s.outcomes.size(), 8u);
   for (const FapOutcome &o : s.outcomes) {
-    SCOPED_TRACE("FAP " + std::to_string(o.fap) + " side " + std::to_string(o.side));
+    if (o.kind != AFM_TARGET_FAP) continue;
+    SCOPED_TRACE("FAP " + std::to_string(o.number) + " side " + std::to_string(o.side));
     ASSERT_TRUE(o.made) << o.message;
-    const MorphTarget *t = target(o.fap, o.side);
+    const MorphTarget *t = target(o.number, o.side);
     ASSERT_NE(t, nullptr);
     EXPECT_EQ(t->reference, o.reference);
     EXPECT_EQ(o.reference > 0, o.side > 0);
@@ -111,7 +176,7 @@ TEST(FapSynthesis, EachTargetMovesItsFdpByReferenceTimesFapuAlongTheFapsDirectio
     ASSERT_EQ(D.rows(), m.tissue.n);
     EXPECT_TRUE(D.allFinite());
     // From the MPEG-4 table and the FAPU, not from the synthesis' own report.
-    const afm_fap_info *info = afm_fap(o.fap);
+    const afm_fap_info *info = afm_fap(o.number);
     const FdpPoint *fdp = m.fdps.find(FdpId{info->fdp_group, info->fdp_index}, m.skin);
     ASSERT_NE(fdp, nullptr);
     const Eigen::Vector3d dir(info->direction[0], info->direction[1], info->direction[2]);
@@ -121,7 +186,7 @@ TEST(FapSynthesis, EachTargetMovesItsFdpByReferenceTimesFapuAlongTheFapsDirectio
     // Muscles: to the solver tolerance, or a FAP unit where the reference was
     // lowered (rounded down). The jaw: its chin is carried rigidly but the
     // tissue around it settles, so within 5 %.
-    const double tol = o.fap == 3 ? 0.05 * std::abs(want) : (o.lowered_from ? unit : 4 * m.solver.tolerance);
+    const double tol = o.number == 3 ? 0.05 * std::abs(want) : (o.lowered_from ? unit : 4 * m.solver.tolerance);
     EXPECT_NEAR(along, want, tol);
     // Only the solved vertices move.
     int moved = 0;
@@ -135,19 +200,28 @@ TEST(FapSynthesis, TheJawsRigidControlMovesTheChinAsTheTargetDoes) {
   const FaceModel &m = head_1k().model;
   const FapSynthesis &s = synthesis();
   ASSERT_FALSE(s.jaw.parts.empty()) << "the reference head has lower teeth and a tongue";
-  ASSERT_EQ(s.jaw.controls.size(), 1u);
-  const RigidPart::Control &c = s.jaw.controls[0];
+  // FAP 3 turns the jaw about x and glides it forward (jaw.h).
+  ASSERT_EQ(s.jaw.controls.size(), 2u);
+  const RigidPart::Control &c = s.jaw.controls[0], &g = s.jaw.controls[1];
   EXPECT_EQ(c.fap, 3);
   EXPECT_EQ(c.dof, AFM_DOF_ROTATE_X);
+  EXPECT_EQ(g.fap, 3);
+  EXPECT_EQ(g.dof, AFM_DOF_TRANSLATE_Z);
   const MorphTarget *t = target(3, +1);
   ASSERT_NE(t, nullptr);
   // At the reference value the rigid turns by gain x reference AU about x
-  // through the pivot: the angle the pose gave the jaw's bone.
-  const double angle = c.gain * t->reference * 1e-5;
+  // through the pivot and moves forward by its glide: the motion the pose
+  // gave the jaw's bone.
+  const double angle = c.gain * t->reference * 1e-5, glide = g.gain * t->reference;
   double scale = 0;
   for (const FapOutcome &o : s.outcomes)
-    if (o.fap == 3) scale = o.scale;
+    if (o.kind == AFM_TARGET_FAP && o.number == 3) scale = o.scale;
   EXPECT_NEAR(angle, scale * m.jaw.max_open, 1e-12);
+  EXPECT_NEAR(glide, scale * m.jaw.open_glide, 1e-12);
+  // The chin drops: the glide takes back most of the rotation's swing
+  // toward the throat (all of it at 100 %).
+  const Eigen::Vector3d chin = at_fdp(*t, 2, 1);
+  EXPECT_LT(std::abs(chin.z()), 0.25 * -chin.y()) << chin.transpose();
   // The skin over the jaw follows the bone through the tissue: on average
   // within 15 % of the rigid motion, or the lower teeth would part from the lip.
   const Eigen::MatrixXd &D = t->displacement[static_cast<size_t>(m.skin)];
@@ -155,7 +229,8 @@ TEST(FapSynthesis, TheJawsRigidControlMovesTheChinAsTheTargetDoes) {
   double off = 0, rigid = 0;
   for (int v : m.jaw.vertices) {
     const Eigen::Vector3d p = m.tissue.X0.row(v).transpose();
-    const Eigen::Vector3d q = s.jaw.pivot + Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitX()) * (p - s.jaw.pivot);
+    const Eigen::Vector3d q = s.jaw.pivot + Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitX()) * (p - s.jaw.pivot) +
+                              glide * Eigen::Vector3d::UnitZ();
     off += (D.row(v).transpose() - (q - p)).norm();
     rigid += (q - p).norm();
   }
@@ -170,6 +245,86 @@ TEST(FapSynthesis, TheCornerGoesUpForPositiveValuesAndDownForNegativeOnes) {
   ASSERT_TRUE(up && down);
   EXPECT_GT(up->displacement[static_cast<size_t>(m.skin)](corner->vertex, 1), 0);
   EXPECT_LT(down->displacement[static_cast<size_t>(m.skin)](corner->vertex, 1), 0);
+}
+
+// Viseme A: opens the jaw by its table's FAP 3 value: the chin drops by
+// value x MNS / 1024 as the bone carries it (the skin over it within 15 %),
+// and the lower teeth move with the bone, rigidly.
+TEST(HighLevel, VisemeAOpensTheJawByItsTableValueAndCarriesTheTeeth) {
+  const FaceModel &m = head_1k().model;
+  const Built &b = head_1k();
+  const MorphTarget *t = high_level_target(AFM_TARGET_VISEME, 10);
+  ASSERT_NE(t, nullptr);
+  EXPECT_EQ(t->reference, 63);
+  const HighLevelMapping *map = find_high_level_mapping(false, 10);
+  const double want = map->jaw_open * m.fapu.mns0 / 1024.0;
+  const double chin = at_fdp(*t, 2, 1).dot(direction_of(3));
+  EXPECT_NEAR(chin, want, 0.15 * want);
+  const int teeth = b.head.scene.find_kind(PartKind::TeethLower);
+  ASSERT_GE(teeth, 0);
+  const Eigen::MatrixXd &D = t->displacement[static_cast<size_t>(teeth)];
+  const Eigen::MatrixXd &V = b.head.scene.parts[static_cast<size_t>(teeth)].V;
+  ASSERT_EQ(D.rows(), V.rows());
+  EXPECT_LT(D.col(1).mean(), -0.5 * want) << "the teeth go down with the chin";
+  const Eigen::MatrixXd P = V + D;
+  for (Eigen::Index i = 1; i < V.rows(); i += 7)
+    EXPECT_NEAR((P.row(i) - P.row(0)).norm(), (V.row(i) - V.row(0)).norm(), 1e-9) << "rigid";
+  // The upper face stays: the brows (4.1) do not move (within a quantum).
+  EXPECT_LT(at_fdp(*t, 4, 1).norm(), m.quantum);
+}
+
+// Joy raises the left mouth corner (8.3) and draws it outward, as FAPs 59
+// and 53 define up and out; sadness lowers it. This model calibrated only
+// the left zygomaticus major and depressor anguli: the outcomes name what
+// was left out.
+TEST(HighLevel, JoyRaisesTheMouthCornerAndSadnessLowersIt) {
+  const MorphTarget *joy = high_level_target(AFM_TARGET_EXPRESSION, 1);
+  const MorphTarget *sad = high_level_target(AFM_TARGET_EXPRESSION, 2);
+  ASSERT_TRUE(joy && sad);
+  const double unit = head_1k().model.fapu.mns0 / 1024.0;
+  const Eigen::Vector3d j = at_fdp(*joy, 8, 3), s = at_fdp(*sad, 8, 3);
+  EXPECT_GT(j.dot(direction_of(59)), 20 * unit) << j.transpose();
+  EXPECT_GT(j.dot(direction_of(53)), 0) << j.transpose();
+  EXPECT_LT(s.dot(direction_of(59)), -20 * unit) << s.transpose();
+  const FapOutcome *o = high_level_outcome(AFM_TARGET_EXPRESSION, 1);
+  ASSERT_NE(o, nullptr);
+  EXPECT_TRUE(o->made);
+  EXPECT_NE(o->message.find("zygomaticus_major_right"), std::string::npos) << o->message;
+  EXPECT_GT(o->largest, j.norm() - 1e-12);
+}
+
+// No target folds the skin or sinks it into the skull: every epidermis
+// triangle keeps its facing, and every skull-tied vertex off the jaw stays
+// above its skull node's tangent plane.
+TEST(FapSynthesis, NoTargetFlipsASkinTriangleOrSinksIntoTheSkull) {
+  const FaceModel &m = head_1k().model;
+  const SkinModel &s = m.tissue;
+  std::vector<char> on_jaw(static_cast<size_t>(s.n), 0);
+  for (int v : m.jaw.vertices) on_jaw[static_cast<size_t>(v)] = 1;
+  const Eigen::MatrixXd R = s.X0.topRows(s.n);
+  auto normal = [&](const Eigen::MatrixXd &X, int f) {
+    const Eigen::Vector3d a = X.row(s.F(f, 0)), b = X.row(s.F(f, 1)), c = X.row(s.F(f, 2));
+    return Eigen::Vector3d((b - a).cross(c - a));
+  };
+  double mean_area = 0;
+  for (int f = 0; f < s.F.rows(); ++f) mean_area += normal(R, f).norm() / static_cast<double>(s.F.rows());
+  ASSERT_FALSE(synthesis().targets.empty());
+  for (const MorphTarget &t : synthesis().targets) {
+    SCOPED_TRACE("target kind " + std::to_string(t.kind) + " number " + std::to_string(t.number));
+    const Eigen::MatrixXd X = R + t.displacement[static_cast<size_t>(m.skin)];
+    int flipped = 0, sunk = 0;
+    for (int f = 0; f < s.F.rows(); ++f) {
+      const Eigen::Vector3d n0 = normal(R, f);
+      if (n0.norm() > 1e-3 * mean_area && n0.dot(normal(X, f)) <= 0) ++flipped;
+    }
+    for (int v = 0; v < s.n; ++v) {
+      if (on_jaw[static_cast<size_t>(v)] || !s.in_mesh[static_cast<size_t>(v)] || !skull_rejects(s, v)) continue;
+      const Eigen::Vector3d n = s.normal.row(v), skull = s.X0.row(s.node(kSkull, v));
+      if ((X.row(v).transpose() - skull).dot(n) < 0) ++sunk;
+    }
+    EXPECT_EQ(flipped, 0);
+    EXPECT_EQ(sunk, 0);
+  }
 }
 
 TEST(FapSynthesis, AMissingMuscleIsAReportNotAnError) {
@@ -221,6 +376,7 @@ TEST(FapSynthesis, TheSameOnAnyNumberOfThreads) {
   const Built &b = head_1k();
   FapSynthesisOptions o;
   o.only = {3, 12, 33};
+  o.only_visemes = {10};
   o.threads = 1;
   Expected<FapSynthesis> one = synthesize_faps(b.head.scene, b.model, o);
   o.threads = 3;
@@ -228,13 +384,14 @@ TEST(FapSynthesis, TheSameOnAnyNumberOfThreads) {
   ASSERT_TRUE(one.is_ok() && three.is_ok());
   ASSERT_EQ(one->targets.size(), three->targets.size());
   for (size_t i = 0; i < one->targets.size(); ++i) {
+    EXPECT_EQ(one->targets[i].kind, three->targets[i].kind);
     EXPECT_EQ(one->targets[i].number, three->targets[i].number);
     EXPECT_EQ(one->targets[i].reference, three->targets[i].reference);
     const size_t skin = static_cast<size_t>(b.model.skin);
     EXPECT_EQ(one->targets[i].displacement[skin], three->targets[i].displacement[skin]) << "bit for bit";
   }
   ASSERT_EQ(one->jaw.controls.size(), three->jaw.controls.size());
-  EXPECT_EQ(one->jaw.controls[0].gain, three->jaw.controls[0].gain);
+  for (size_t i = 0; i < one->jaw.controls.size(); ++i) EXPECT_EQ(one->jaw.controls[i].gain, three->jaw.controls[i].gain);
 }
 
 TEST(FapSynthesis, TheAfmHoldsTheTargetsAndTheJaw) {
@@ -253,13 +410,15 @@ TEST(FapSynthesis, TheAfmHoldsTheTargetsAndTheJaw) {
   for (uint32_t i = 0; i < doc->target_count; ++i) {
     bool found = false;
     for (const MorphTarget &t : s.targets)
-      found |= t.number == doc->targets[i].number && t.reference == doc->targets[i].reference;
+      found |= t.kind == doc->targets[i].kind && t.number == doc->targets[i].number &&
+               t.reference == doc->targets[i].reference;
     EXPECT_TRUE(found) << "target " << int(doc->targets[i].number) << " ref " << doc->targets[i].reference;
   }
   bool jaw = false;
   for (uint32_t i = 0; i < doc->rigid_count; ++i)
     if (doc->rigids[i].kind == AFM_RIGID_JAW)
-      jaw = doc->rigids[i].control_count == 1 && doc->rigids[i].controls[0].fap == 3;
+      jaw = doc->rigids[i].control_count == 2 && doc->rigids[i].controls[0].fap == 3 &&
+            doc->rigids[i].controls[1].fap == 3;
   EXPECT_TRUE(jaw);
 }
 

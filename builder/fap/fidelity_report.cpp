@@ -1,0 +1,271 @@
+#include "fap/fidelity_report.h"
+
+#include <afm/mpeg4.h>
+#include <afm/render.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <filesystem>
+#include <system_error>
+
+#include "core/atomic_file.h"
+#include "core/fapu.h"
+#include "render/scene_render.h"
+
+namespace afmb {
+
+namespace {
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+double worst(const std::vector<double> &v) { return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end()); }
+
+std::string format(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+std::string format(const char *fmt, ...) {
+  char buf[1024];
+  va_list ap;
+  va_start(ap, fmt);
+  std::vsnprintf(buf, sizeof buf, fmt, ap);
+  va_end(ap);
+  return buf;
+}
+
+// "fap03", "fap03-neg", "viseme01", "expression1".
+std::string file_stem(const FapOutcome &o) {
+  if (o.kind == AFM_TARGET_VISEME) return format("viseme%02d", o.number);
+  if (o.kind == AFM_TARGET_EXPRESSION) return format("expression%d", o.number);
+  return format("fap%02d%s", o.number, o.side < 0 ? "-neg" : "");
+}
+
+std::string html_escape(const std::string &s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '&') out += "&amp;";
+    else if (c == '<') out += "&lt;";
+    else if (c == '>') out += "&gt;";
+    else if (c == '"') out += "&quot;";
+    else out += c;
+  }
+  return out;
+}
+
+std::string csv_quote(const std::string &s) {
+  std::string out = "\"";
+  for (char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return out + "\"";
+}
+
+// The FDP a FAP target is measured at (skin vertex), or -1.
+int fap_fdp_vertex(const FaceModel &model, const FapOutcome &o) {
+  if (o.kind != AFM_TARGET_FAP) return -1;
+  const afm_fap_info *info = afm_fap(o.number);
+  const FdpPoint *p = info ? model.fdps.find(FdpId{info->fdp_group, info->fdp_index}, model.skin) : nullptr;
+  return p && p->part == model.skin ? p->vertex : -1;
+}
+
+// The jaw's rigid motion at a jaw FAP's reference value (identity for other
+// targets): the control the synthesis gave the jaw's parts.
+Eigen::Affine3d jaw_at_reference(const FapSynthesis &s, const FapOutcome &o) {
+  Eigen::Affine3d t = Eigen::Affine3d::Identity();
+  if (o.kind != AFM_TARGET_FAP) return t;
+  // As the player composes them: p' = R (p - pivot) + pivot + translation.
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d move = Eigen::Vector3d::Zero();
+  for (const RigidPart::Control &c : s.jaw.controls) {
+    if (c.fap != o.number) continue;
+    const double amount = c.gain * o.reference;
+    const Eigen::Vector3d a = s.jaw.axes.row(c.dof % 3).transpose();  // rows: local axes
+    if (c.dof < 3) R = Eigen::AngleAxisd(amount * 1e-5, a).toRotationMatrix() * R;
+    else move += amount * a;
+  }
+  t.linear() = R;
+  t.translation() = s.jaw.pivot - R * s.jaw.pivot + move;
+  return t;
+}
+
+}  // namespace
+
+std::string target_label(const FapOutcome &o) {
+  if (o.kind == AFM_TARGET_VISEME) return "viseme " + std::string(afm_viseme_phonemes(o.number));
+  if (o.kind == AFM_TARGET_EXPRESSION) return afm_expression_name(o.number);
+  const afm_fap_info *info = afm_fap(o.number);
+  return std::string(info ? info->name : "fap") + (o.side < 0 ? " (negative)" : "");
+}
+
+std::string fidelity_table(const FapSynthesis &s) {
+  std::string out = format("%-4s %-34s %6s %8s %10s %10s %8s %8s %7s\n", "fap", "name", "ref", "scale", "prescribed",
+                           "achieved", "along", "off-axis", "V_d");
+  std::vector<double> along, off;
+  int failed = 0;
+  for (const FapOutcome &o : s.outcomes) {
+    const std::string id = o.kind == AFM_TARGET_VISEME       ? format("v%d", o.number)
+                           : o.kind == AFM_TARGET_EXPRESSION ? format("e%d", o.number)
+                                                             : format("%d", o.number);
+    const std::string name = target_label(o);
+    if (!o.made) {
+      ++failed;
+      out += format("%-4s %-34s %6d  not made: %s\n", id.c_str(), name.c_str(), o.reference, o.message.c_str());
+      continue;
+    }
+    if (o.kind != AFM_TARGET_FAP) {
+      out += format("%-4s %-34s %6d %8s %10s %10.4g %8s %8s %7d%s%s\n", id.c_str(), name.c_str(), o.reference, "-",
+                    "-", o.largest, "-", "-", o.dynamic, o.message.empty() ? "" : "  ", o.message.c_str());
+      continue;
+    }
+    along.push_back(o.along_error);
+    off.push_back(o.off_axis);
+    out += format("%-4s %-34s %6d %8.3f %10.4g %10.4g %7.2f%% %7.1f%% %7d%s%s\n", id.c_str(), name.c_str(),
+                  o.reference, o.scale, o.prescribed.norm(), o.achieved.norm(), 100 * o.along_error,
+                  100 * o.off_axis, o.dynamic, o.lowered_from ? "  " : "", o.lowered_from ? o.message.c_str() : "");
+  }
+  out += format("targets: %zu made, %d not made; FAPs along the direction median %.2f%% worst %.2f%%; off-axis "
+                "median %.1f%% worst %.1f%% (visemes and expressions: achieved = largest motion)\n",
+                s.targets.size(), failed, 100 * median(along), 100 * worst(along), 100 * median(off),
+                100 * worst(off));
+  return out;
+}
+
+Status write_fidelity_report(const std::string &dir, const Scene &scene, const FaceModel &model,
+                             const FapSynthesis &s, const FidelityReportOptions &options) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(fs::path(dir) / "targets", ec);
+  if (ec) return Status::error(dir + ": cannot make the report directory: " + ec.message());
+  const std::string sep = "/";
+
+  // The text and CSV tables.
+  const std::string table = fidelity_table(s);
+  if (Status st = write_file_atomic(dir + sep + "report.txt", table); !st) return st;
+  std::string csv =
+      "kind,number,name,side,reference,lowered_from,made,scale,prescribed_x,prescribed_y,prescribed_z,achieved_x,"
+      "achieved_y,achieved_z,along_error,off_axis,largest,dynamic,seconds,message\n";
+  for (const FapOutcome &o : s.outcomes)
+    csv += format("%s,%d,%s,%d,%d,%d,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%.3f,",
+                  o.kind == AFM_TARGET_FAP ? "fap" : o.kind == AFM_TARGET_VISEME ? "viseme" : "expression",
+                  o.number, csv_quote(target_label(o)).c_str(), o.side, o.reference, o.lowered_from, o.made ? 1 : 0,
+                  o.scale, o.prescribed.x(), o.prescribed.y(), o.prescribed.z(), o.achieved.x(), o.achieved.y(),
+                  o.achieved.z(), o.along_error, o.off_axis, o.largest, o.dynamic, o.seconds) +
+           csv_quote(o.message) + "\n";
+  if (Status st = write_file_atomic(dir + sep + "report.csv", csv); !st) return st;
+
+  // The pictures: the neutral face, then every made target.
+  SceneRenderOptions ro;
+  ro.width = options.tile_width;
+  ro.height = options.tile_height;
+  ro.views = {SceneView{}};
+  ro.face_closeup = true;
+  ro.fdp_dot_pixels = 0;
+  const size_t skin = static_cast<size_t>(model.skin);
+  const Part &skin_part = scene.parts[skin];
+  Eigen::MatrixXd base = skin_part.C;
+  if (base.rows() != skin_part.V.rows()) base = skin_part.diffuse.transpose().replicate(skin_part.V.rows(), 1);
+
+  std::vector<std::vector<uint8_t>> tiles;
+  std::vector<std::string> tile_names;
+  const int total = 1 + static_cast<int>(s.targets.size());
+  auto picture = [&](const std::string &stem, const Scene &posed, const std::vector<SceneMarkers> &markers) -> Status {
+    ro.markers = markers;
+    Expected<std::vector<std::vector<uint8_t>>> img = render_scene(posed, &model.fdps, ro);
+    if (!img) return img.status().wrap(dir + sep + "targets" + sep + stem + ".png");
+    const std::string path = dir + sep + "targets" + sep + stem + ".png";
+    afm_render_image image{img->front().data(), ro.width, ro.height};
+    if (afm_png_write(path.c_str(), &image) != AFM_OK)
+      return Status::error(path + ": " + afm_render_last_error());
+    tiles.push_back(std::move(img->front()));
+    tile_names.push_back(stem);
+    if (options.progress) options.progress(static_cast<int>(tiles.size()), total, stem);
+    return Status::ok();
+  };
+  if (Status st = picture("neutral", scene, {}); !st) return st;
+
+  size_t next = 0;  // targets are the made outcomes, in order
+  for (const FapOutcome &o : s.outcomes) {
+    if (!o.made) continue;
+    const MorphTarget &t = s.targets[next++];
+    Scene posed = scene;
+    const Eigen::Affine3d jaw = jaw_at_reference(s, o);
+    for (size_t p = 0; p < posed.parts.size() && p < t.displacement.size(); ++p)
+      if (t.displacement[p].rows() == posed.parts[p].V.rows()) posed.parts[p].V += t.displacement[p];
+    if (!jaw.matrix().isIdentity(0))
+      for (int p : s.jaw.parts) {
+        Eigen::MatrixXd &V = posed.parts[static_cast<size_t>(p)].V;
+        V = ((V * jaw.linear().transpose()).rowwise() + jaw.translation().transpose()).eval();
+      }
+    // Red where the skin moves, in proportion to the target's largest motion.
+    const Eigen::MatrixXd &D = t.displacement[skin];
+    if (D.rows() == base.rows()) {
+      const Eigen::VectorXd len = D.rowwise().norm();
+      const double most = std::max(len.maxCoeff(), 1e-30);
+      Eigen::MatrixXd C = base;
+      for (Eigen::Index v = 0; v < C.rows(); ++v) {
+        const double w = std::sqrt(std::min(1.0, len(v) / most));
+        C.row(v) = (1 - w) * base.row(v) + w * Eigen::RowVector3d(0.9, 0.1, 0.1);
+      }
+      posed.parts[skin].C = C;
+    }
+    std::vector<SceneMarkers> markers;
+    if (const int v = fap_fdp_vertex(model, o); v >= 0) {
+      const Eigen::RowVector3d rest = skin_part.V.row(v);
+      SceneMarkers at, goal;
+      at.points = rest;
+      at.color = {1.0f, 0.9f, 0.1f};
+      at.size_pixels = 5;
+      goal.points = rest + o.prescribed.transpose();
+      goal.color = {0.1f, 0.9f, 0.2f};
+      goal.size_pixels = 5;
+      markers = {at, goal};
+    }
+    if (Status st = picture(file_stem(o), posed, markers); !st) return st;
+  }
+
+  // The contact sheet.
+  std::vector<afm_render_image> images;
+  for (const std::vector<uint8_t> &tile : tiles) images.push_back({tile.data(), ro.width, ro.height});
+  const uint8_t background[4] = {255, 255, 255, 255};
+  const std::string sheet = dir + sep + "sheet.png";
+  if (afm_sheet_write_png(sheet.c_str(), images.data(), static_cast<int>(images.size()), 10, 4, background) !=
+      AFM_OK)
+    return Status::error(sheet + ": " + afm_render_last_error());
+
+  // The page: the summary, then a row per target with its picture.
+  std::string html =
+      "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>FAP synthesis: fidelity report</title>\n"
+      "<style>body{font-family:sans-serif}td,th{padding:2px 8px;text-align:right}td.l,th.l{text-align:left}"
+      "img{width:120px}</style></head><body>\n<h1>FAP synthesis: fidelity report</h1>\n";
+  html += "<p>" + html_escape(table.substr(table.rfind("targets:"))) + "</p>\n";
+  html += "<p>Pictures: the face at each target's reference value, the skin red where it moves (full red at "
+          "its largest motion); a FAP's FDP at rest in yellow, where MPEG-4 puts it in green. "
+          "<a href=\"sheet.png\">Contact sheet</a> (neutral first, then this table's order), "
+          "<a href=\"report.csv\">CSV</a>.</p>\n<table>\n<tr><th>picture</th><th>#</th><th class=\"l\">name</th>"
+          "<th>ref</th><th>scale</th><th>prescribed</th><th>achieved</th><th>along</th><th>off-axis</th>"
+          "<th class=\"l\">note</th></tr>\n";
+  html += "<tr><td><img src=\"targets/neutral.png\"></td><td></td><td class=\"l\">neutral</td><td colspan=7></td></tr>\n";
+  for (const FapOutcome &o : s.outcomes) {
+    const std::string num = o.kind == AFM_TARGET_VISEME       ? format("v%d", o.number)
+                            : o.kind == AFM_TARGET_EXPRESSION ? format("e%d", o.number)
+                                                              : format("%d", o.number);
+    html += "<tr><td>";
+    if (o.made) html += "<img src=\"targets/" + file_stem(o) + ".png\">";
+    html += "</td><td>" + num + "</td><td class=\"l\">" + html_escape(target_label(o)) + "</td>";
+    html += format("<td>%d</td>", o.reference);
+    if (!o.made) {
+      html += "<td colspan=5></td>";
+    } else if (o.kind != AFM_TARGET_FAP) {
+      html += format("<td></td><td></td><td>%.4g</td><td></td><td></td>", o.largest);
+    } else {
+      html += format("<td>%.3f</td><td>%.4g</td><td>%.4g</td><td>%.2f%%</td><td>%.1f%%</td>", o.scale,
+                     o.prescribed.norm(), o.achieved.norm(), 100 * o.along_error, 100 * o.off_axis);
+    }
+    html += "<td class=\"l\">" + html_escape(o.made ? o.message : "not made: " + o.message) + "</td></tr>\n";
+  }
+  html += "</table></body></html>\n";
+  return write_file_atomic(dir + sep + "index.html", html);
+}
+
+}  // namespace afmb

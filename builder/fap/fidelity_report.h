@@ -1,0 +1,51 @@
+// The fidelity report of a FAP synthesis (issue 5, `afm-build --report DIR`):
+// per target, the prescribed against the achieved FDP displacement and the
+// errors along and off the FAP's direction, with the median and the worst;
+// and a picture of every target.
+//
+// Files written into DIR (created when missing; its parent must exist), each
+// atomically:
+//   report.txt     the table afm-build prints, and the summary
+//   report.csv     the same, one row per attempted target, for scripts
+//   targets/*.png  one picture per made target: the face at the target
+//                  (reference value), the skin tinted red where it moves
+//                  (full red at the target's largest motion); for a FAP,
+//                  its FDP at rest (yellow) and where MPEG-4 puts it at the
+//                  reference (green); neutral.png is the face at rest
+//   sheet.png      a contact sheet of those pictures, neutral first, then in
+//                  the table's order (row by row)
+//   index.html     the table with the pictures beside each row
+#pragma once
+
+#include <functional>
+#include <string>
+
+#include "anatomy/face_model.h"
+#include "core/scene.h"
+#include "core/status.h"
+#include "fap/fap_synthesis.h"
+
+namespace afmb {
+
+// A target's name in reports and file names: the FAP's MPEG-4 name ("open_jaw",
+// "raise_l_cornerlip (negative)"), "viseme p, b, m", or the expression's.
+std::string target_label(const FapOutcome &outcome);
+
+// The table: a line per attempted target, then one summary line: targets
+// made and not, and over the FAP targets the median and worst error along
+// the direction and off it.
+std::string fidelity_table(const FapSynthesis &synthesis);
+
+struct FidelityReportOptions {
+  int tile_width = 240, tile_height = 288;  // pixels per picture
+  // Called after each picture: done of total (from the calling thread).
+  std::function<void(int done, int total, const std::string &what)> progress;
+};
+
+// Writes the report of `synthesis`, made from `model` (built from `scene`),
+// into `dir`. Fails when the directory cannot be made or a file written, or
+// a picture cannot be rendered; the message names the file.
+Status write_fidelity_report(const std::string &dir, const Scene &scene, const FaceModel &model,
+                             const FapSynthesis &synthesis, const FidelityReportOptions &options = {});
+
+}  // namespace afmb
