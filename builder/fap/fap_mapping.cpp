@@ -58,10 +58,13 @@ std::vector<FapMapping> make_table() {
   add(18, D::Muscles, 300, {{"mentalis_left", 100}, {"mentalis_right", 100}},
       {{"mentalis_left", -100}, {"mentalis_right", -100}}, "mentalis lifts the chin's skin");
   // ---- group 3: eyelids, eyeballs, pupils ----
-  add(19, D::Muscles, 300, {{"orbicularis_oculi_left", 100}}, {{"orbicularis_oculi_left", -100}}, "");
-  add(20, D::Muscles, 300, {{"orbicularis_oculi_right", 100}}, {{"orbicularis_oculi_right", -100}}, "");
-  add(21, D::Muscles, 300, {{"orbicularis_oculi_left", 100}}, {{"orbicularis_oculi_left", -100}}, "");
-  add(22, D::Muscles, 300, {{"orbicularis_oculi_right", 100}}, {{"orbicularis_oculi_right", -100}}, "");
+  const char *upper = "the upper lid's half of orbicularis oculi's pose";
+  const char *lower = "the lower lid's half of orbicularis oculi's pose";
+  add(19, D::Muscles, 300, {{"orbicularis_oculi_left", 100}}, {{"orbicularis_oculi_left", -100}}, upper);
+  add(20, D::Muscles, 300, {{"orbicularis_oculi_right", 100}}, {{"orbicularis_oculi_right", -100}}, upper);
+  add(21, D::Muscles, 300, {{"orbicularis_oculi_left", 100}}, {{"orbicularis_oculi_left", -100}}, lower);
+  add(22, D::Muscles, 300, {{"orbicularis_oculi_right", 100}}, {{"orbicularis_oculi_right", -100}}, lower);
+  for (size_t k = t.size() - 4; k < t.size(); ++k) t[k].lid = t[k].fap <= 20 ? +1 : -1;
   for (int f = 23; f <= 28; ++f) add(f, D::Rigid, 0, {}, {}, rigid_eye);
   add(29, D::None, 0, {}, {}, "pupil dilation needs pupil geometry, which the eye parts do not have");
   add(30, D::None, 0, {}, {}, "pupil dilation needs pupil geometry, which the eye parts do not have");

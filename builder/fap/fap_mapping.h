@@ -43,6 +43,11 @@ struct FapMapping {
   // the positive target is extrapolated (the report checks that side).
   std::vector<FapContraction> negative;
   const char *note = "";                    // why (None), or a remark
+  // Eyelid FAPs (19-22): one orbicularis oculi closes both lids, so the
+  // target keeps only its lid's half of the pose: +1 the upper lid, -1 the
+  // lower, split at the height halfway between the lid centres (3.1/3.3 or
+  // 3.2/3.4) and blended over the lids' opening. 0: the whole pose.
+  int lid = 0;
 };
 
 // Every FAP 3..68 once, in number order.

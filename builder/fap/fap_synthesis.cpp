@@ -44,6 +44,21 @@ std::string fap_label(int fap, int side) {
   return std::string(info ? info->name : "fap") + (side < 0 ? " (negative)" : "");
 }
 
+// Eyelid FAPs: weights the rows of D (#V x 3) by the lid's half (fap_mapping.h):
+// a smooth step in height across the lids' opening, 1 at the lid's centre.
+void keep_lid_half(const FaceModel &model, int fap, int lid, Eigen::MatrixXd &D) {
+  const bool left = fap == 19 || fap == 21;
+  const FdpPoint *up = model.fdps.find(FdpId{3, left ? 1 : 2}, model.skin);
+  const FdpPoint *down = model.fdps.find(FdpId{3, left ? 3 : 4}, model.skin);
+  if (!up || !down || up->vertex < 0 || down->vertex < 0) return;
+  const double y_up = model.tissue.X0(up->vertex, 1), y_down = model.tissue.X0(down->vertex, 1);
+  const double mid = 0.5 * (y_up + y_down), open = std::max(std::abs(y_up - y_down), 1e-12);
+  for (Eigen::Index v = 0; v < D.rows(); ++v) {
+    const double s = std::clamp(lid * (model.tissue.X0(v, 1) - mid) / open + 0.5, 0.0, 1.0);
+    D.row(v) *= s * s * (3 - 2 * s);
+  }
+}
+
 std::string high_level_label(const HighLevelMapping &h) {
   return h.expression ? std::string(afm_expression_name(h.number))
                       : "viseme " + std::string(afm_viseme_phonemes(h.number));
@@ -294,7 +309,8 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       }
     }
     if (ok) {
-      const Eigen::MatrixXd D = pose_epidermis(model, pose) - skin.X0.topRows(skin.n);
+      Eigen::MatrixXd D = pose_epidermis(model, pose) - skin.X0.topRows(skin.n);
+      if (map->lid) keep_lid_half(model, map->fap, map->lid, D);
       o.achieved = D.row(fdp->vertex).transpose();
       const double len = o.prescribed.norm();
       const double a = o.achieved.dot(dir);
