@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <mutex>
 #include <optional>
 
@@ -190,6 +191,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     const FdpPoint *fdp = model.fdps.find(FdpId{info->fdp_group, info->fdp_index}, model.skin);
     Pose pose;
     bool ok = false;
+    double shrink = 1;  // on the target, when a capped pose lies just beyond the value
     if (!fdp || fdp->part != model.skin || fdp->vertex < 0) {
       o.message = "its FDP " + std::to_string(info->fdp_group) + "." + std::to_string(info->fdp_index) +
                   " is not on the skin";
@@ -296,12 +298,22 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
                                      : "the group moves the FDP less than a FAP unit";
               o.message += " (reference " + std::to_string(map->reference) + ": " + why + ")";
             } else {
+              // Kept at the table's reference: the target is the most the
+              // group does, so streams at the reference see the muscles at
+              // their range instead of a small target extrapolated many times.
               pose = std::move(*full);
               o.scale = 1;
-              o.lowered_from = map->reference;
-              o.reference = side * r;
-              o.prescribed = side * r * unit * dir;
-              o.message = "reference lowered from " + std::to_string(map->reference) + ": " + why;
+              if (reach >= value) {
+                // The load control stopped at the cap just short of the value,
+                // and the equilibrium there lies beyond it: scale the few
+                // percent back.
+                shrink = value / reach;
+              } else {
+                o.reached = reach / value;
+                char pct[32];
+                std::snprintf(pct, sizeof pct, "%.0f %%", 100 * o.reached);
+                o.message = std::string("reaches ") + pct + " of the prescribed motion: " + why;
+              }
               ok = true;
             }
           }
@@ -309,7 +321,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       }
     }
     if (ok) {
-      Eigen::MatrixXd D = pose_epidermis(model, pose) - skin.X0.topRows(skin.n);
+      Eigen::MatrixXd D = shrink * (pose_epidermis(model, pose) - skin.X0.topRows(skin.n));
       if (map->lid) keep_lid_half(model, map->fap, map->lid, D);
       o.achieved = D.row(fdp->vertex).transpose();
       const double len = o.prescribed.norm();

@@ -17,16 +17,18 @@
 //
 // The scale stays within the muscles' calibrated range (s <= 1 with the
 // table's contractions at 100 %). A group that cannot reach the reference
-// there makes its target at s = 1, and the reference becomes what it reaches
-// (rounded down to whole FAP units): the MPEG-4 rule still holds, and the
-// outcome says the reference was lowered and why. A group that moves its
-// FDP the wrong way, or by less than a FAP unit, gets no target.
+// there makes its target at s = 1 and keeps the table's reference: the
+// target under-reaches (the outcome says by how much), and a stream at the
+// reference shows the muscles at their range. (Lowering the reference to
+// what the group reaches kept the MPEG-4 rule exact, but real streams then
+// extrapolated small targets up to 90 times and tore the face.) A group that
+// moves its FDP the wrong way, or by less than a FAP unit, gets no target.
 //
 // What is measured per target (the fidelity report): the prescribed FDP
 // displacement, the achieved one, the error along the FAP's direction and
 // off it, both relative to the prescribed length. Along the direction the
-// error is the solver's tolerance (or the rounding of a lowered reference)
-// by construction; off it is the anatomy's answer.
+// error is the solver's tolerance by construction, or 1 - reached where the
+// group under-reaches; off it is the anatomy's answer.
 #pragma once
 
 #include <Eigen/Core>
@@ -46,9 +48,9 @@ struct FapOutcome {
   int side = +1;                  // +1: the positive reference, -1: the negative one
   int reference = 0;              // signed FAP units (63 for visemes and expressions)
   bool made = false;              // a target was made
-  std::string message;            // why not, when !made; why the reference was lowered
-  int lowered_from = 0;           // the table's reference when the group could not reach it
-                                  // within its calibrated range (else 0)
+  std::string message;            // why not, when !made; how far it reaches when it under-reaches
+  double reached = 1;             // the achieved share of the prescribed motion along the
+                                  // direction when the group under-reaches (< 1), else 1
   Eigen::Vector3d prescribed = Eigen::Vector3d::Zero();  // FDP displacement, model units
   Eigen::Vector3d achieved = Eigen::Vector3d::Zero();
   double along_error = 0;         // |achieved . dir - prescribed . dir| / |prescribed|

@@ -1,0 +1,41 @@
+#!/bin/sh
+# The main job on a real face: build the Song head's anatomical AFM (VRML97,
+# 10 parts, XfaceEd FDPs) with its fidelity report, play a real FAP stream
+# (Xface's joy.fap) with the fixed-point player and render frames of it.
+# Needs ../shared/data; skips with a message without it. Under the
+# sanitizers (AFM_CONFIG=sanitize) only a few targets are made: the model is
+# the same, the synthesis of all of them would take too long there.
+test_name=test_song.sh
+. "$(dirname "$0")/lib/common.sh"
+: "${AFM_SHARED_DIR:=$(dirname "$0")/../../../shared}"
+song="$AFM_SHARED_DIR/data/faces/song"
+stream="$AFM_SHARED_DIR/data/fap/xface/joy.fap"
+if [ ! -f "$song/song.WRL" ] || [ ! -f "$stream" ]; then
+  echo "test_song.sh: skipped: $AFM_SHARED_DIR/data (the Song head, the Xface streams) is absent"
+  exit 0
+fi
+
+if [ "${AFM_CONFIG:-release}" = sanitize ]; then
+  subset="--faps 3,12,19,v10,e1" want=7
+else
+  subset="" want=90
+fi
+# shellcheck disable=SC2086
+"$bin/afm-build" "$song/song.WRL" "$song/song.fdp" --flip-v -q -o "$tmp/song.afm" --report "$tmp/report" $subset \
+  >"$tmp/build.txt" 2>&1 || fail "the Song build failed: $(tail -n 5 "$tmp/build.txt")"
+made=$(sed -n 's/^targets: \([0-9]*\) made.*/\1/p' "$tmp/build.txt")
+[ -n "$made" ] && [ "$made" -ge "$want" ] || fail "Song: ${made:-no} targets made, expected at least $want"
+grep -q "^e1  *joy  *63 " "$tmp/build.txt" || fail "Song: no joy target: $(grep -c . "$tmp/build.txt") lines"
+[ -s "$tmp/report/sheet.png" ] && [ -s "$tmp/report/index.html" ] || fail "Song: no fidelity report"
+
+"$bin/afm-play" "$tmp/song.afm" "$stream" >"$tmp/play.txt" 2>&1 || fail "afm-play failed on Song: $(tail -n 3 "$tmp/play.txt")"
+# A line per frame with its pose hash: the face must move, so the hashes vary.
+hashes=$(awk '$1 == "frame" { print $NF }' "$tmp/play.txt" | sort -u | wc -l)
+[ "$hashes" -gt 10 ] || fail "afm-play: the Song pose changes in only $hashes of the stream's frames"
+
+"$bin/afm-render" "$tmp/song.afm" "$stream" -o "$tmp/frames" --frames 0:60 --size 320x400 --closeup --textures "$song" \
+  --sheet "$tmp/sheet.png" --sheet-frames 0,30,60 >"$tmp/render.txt" 2>&1 ||
+  fail "afm-render failed on Song: $(tail -n 3 "$tmp/render.txt")"
+[ "$(ls "$tmp/frames" 2>/dev/null | grep -c '^frame_.*\.png$')" -eq 61 ] || fail "afm-render: not 61 frames"
+cmp -s "$tmp/frames/frame_00000.png" "$tmp/frames/frame_00030.png" && fail "frame 30 looks like frame 0: nothing moved"
+finish "Song: $made targets; frames in $tmp/frames"
