@@ -124,8 +124,11 @@ int main(int argc, char **argv) {
     stream = std::move(*s);
   }
 
-  // Files of this run, removed again when a later output fails.
+  // Files of this run, removed again when a later output fails; the
+  // summary is printed once every output is written.
   std::vector<std::string> written;
+  std::string summary;
+  char line[512];
   auto fail_run = [&written](const Status &s) {
     std::error_code ec;
     for (const std::string &f : written) std::filesystem::remove(f, ec);
@@ -145,26 +148,28 @@ int main(int argc, char **argv) {
     GltfStats st;
     if (Status s = export_gltf(d, afm_path, gltf_path, o, &st); !s) return fail_run(s);
     written.push_back(gltf_path);
-    if (!quiet)
-      std::printf("%s: glTF, %zu bytes: %zu meshes, %zu nodes, %zu of %u morph targets (%zu on meshes), "
+    std::snprintf(line, sizeof line,
+                  "%s: glTF, %zu bytes: %zu meshes, %zu nodes, %zu of %u morph targets (%zu on meshes), "
                   "%zu animation keys, %zu textures\n",
                   gltf_path.c_str(), st.bytes, st.meshes, st.nodes, st.targets, d.target_count,
                   st.mesh_targets, st.frames, st.textures);
+    summary += line;
   }
   if (!vrml_path.empty()) {
     VrmlExportStats st;
     if (Status s = export_vrml(d, afm_path, vrml_path, &st); !s) return fail_run(s);
     written.push_back(vrml_path);
-    if (!quiet)
-      std::printf("%s: VRML97, %zu bytes: %u parts, %u morph targets in %zu shapes\n", vrml_path.c_str(),
-                  st.bytes, d.geometry.part_count, d.target_count, st.target_shapes);
+    std::snprintf(line, sizeof line, "%s: VRML97, %zu bytes: %u parts, %u morph targets in %zu shapes\n",
+                  vrml_path.c_str(), st.bytes, d.geometry.part_count, d.target_count, st.target_shapes);
+    summary += line;
   }
   if (!obj_dir.empty()) {
     ObjExportStats st;
     if (Status s = export_obj(d, obj_dir, progress_printer(quiet, "OBJ", 50), &st); !s) return fail_run(s);
-    if (!quiet)
-      std::printf("%s: %zu OBJ files (neutral + %u targets), %zu bytes\n", obj_dir.c_str(), st.files,
-                  d.target_count, st.bytes);
+    std::snprintf(line, sizeof line, "%s: %zu OBJ files (neutral + %u targets), %zu bytes\n",
+                  obj_dir.c_str(), st.files, d.target_count, st.bytes);
+    summary += line;
   }
+  if (!quiet) std::fputs(summary.c_str(), stdout);
   return 0;
 }
