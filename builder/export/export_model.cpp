@@ -3,29 +3,15 @@
 #include <afm/draco.h>
 #include <afm/mpeg4.h>
 
-#include <cerrno>
 #include <cmath>
-#include <cstring>
+
+#include "core/atomic_file.h"
 
 namespace afmb {
 
 void AfmDocFree::operator()(afm_doc *doc) const { afm_free(nullptr, doc); }
 
 namespace {
-
-Expected<std::vector<uint8_t>> read_bytes(const std::string &path) {
-  uint8_t *data = nullptr;
-  size_t size = 0;
-  errno = 0;
-  const afm_result r = afm_file_read(path.c_str(), nullptr, &data, &size);
-  if (r != AFM_OK) {
-    const int e = errno;
-    return Status::error(path + ": cannot read: " + (e ? std::strerror(e) : afm_result_string(r)));
-  }
-  std::vector<uint8_t> out(data, data + size);
-  afm_free(nullptr, data);
-  return out;
-}
 
 double round_to(double x, int decimals) {
   const double scale = std::pow(10.0, decimals);
@@ -35,30 +21,32 @@ double round_to(double x, int decimals) {
 }  // namespace
 
 Expected<AfmDocPtr> read_afm_file(const std::string &path) {
-  Expected<std::vector<uint8_t>> bytes = read_bytes(path);
+  Expected<std::string> bytes = read_file(path);
   if (!bytes) return bytes.status();
+  const uint8_t *data = reinterpret_cast<const uint8_t *>(bytes->data());
   afm_diag diag{};
   afm_read_options options{};
   options.draco = afm_draco_codec();
   options.diag = &diag;
   afm_doc *doc = nullptr;
-  const afm_result r = afm_doc_read_alloc(bytes->data(), bytes->size(), &options, nullptr, &doc);
+  const afm_result r = afm_doc_read_alloc(data, bytes->size(), &options, nullptr, &doc);
   if (r != AFM_OK)
     return Status::error(path + ": " + (diag.message[0] ? diag.message : afm_result_string(r)));
   return AfmDocPtr(doc);
 }
 
 Expected<FapStream> read_fap_file(const std::string &path) {
-  Expected<std::vector<uint8_t>> bytes = read_bytes(path);
+  Expected<std::string> bytes = read_file(path);
   if (!bytes) return bytes.status();
+  const uint8_t *data = reinterpret_cast<const uint8_t *>(bytes->data());
   FapStream s;
   afm_diag diag{};
   uint32_t count = 0;
-  afm_result r = afm_fap_parse(bytes->data(), bytes->size(), nullptr, nullptr, 0, &count, nullptr,
+  afm_result r = afm_fap_parse(data, bytes->size(), nullptr, nullptr, 0, &count, nullptr,
                                nullptr, &diag);
   if (r == AFM_OK && count > 0) {
     s.frames.resize(count);
-    r = afm_fap_parse(bytes->data(), bytes->size(), nullptr, s.frames.data(), count, &count,
+    r = afm_fap_parse(data, bytes->size(), nullptr, s.frames.data(), count, &count,
                       &s.header, nullptr, &diag);
   }
   if (r != AFM_OK) {

@@ -154,7 +154,7 @@ expect_error "no model" 2 "no model" - -- "$export_tool" --gltf "$e/a.glb"
 expect_error "--fap without --gltf" 2 "needs --gltf" - -- "$export_tool" "$model" --vrml "$e/a.wrl" --fap "$tmp/move.fap"
 expect_error "unknown option" 2 "unknown option --bogus" - -- "$export_tool" "$model" --bogus
 expect_error "missing value" 2 "--obj needs a directory" - -- "$export_tool" "$model" --obj
-expect_error "missing model" 1 "nothing.afm: cannot read" "$e/a.glb" -- "$export_tool" "$tmp/nothing.afm" --gltf "$e/a.glb"
+expect_error "missing model" 1 "nothing.afm: cannot open" "$e/a.glb" -- "$export_tool" "$tmp/nothing.afm" --gltf "$e/a.glb"
 printf 'not an AFM file at all, but long enough to be read' >"$e/bad.afm"
 expect_error "not an AFM" 1 "bad.afm: " "$e/a.glb" -- "$export_tool" "$e/bad.afm" --gltf "$e/a.glb"
 { printf '2.1 cli 25 2\n'; mask; printf '0 0 0 0 0\n'; mask; printf '1 zero 0 0 0\n'; } >"$e/bad.fap"
