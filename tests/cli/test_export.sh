@@ -135,6 +135,15 @@ awk '
   $1 == "changed:" { seen = 1; if ($2 < 1) { print "the played frame differs from the neutral one in " $2 " % of pixels"; bad = 1 } }
   END { exit bad || !seen }' "$tmp/view.txt" >"$tmp/judge.txt" || fail "screenshots: $(cat "$tmp/judge.txt")"
 
+# --- a textured skin (the neutral screenshot as its image): embedded, still valid
+sed '0,/appearance Appearance {/s//appearance Appearance { texture ImageTexture { url "skin.png" }/' \
+  "$tmp/head.wrl" >"$tmp/tex.wrl"
+cp "$tmp/shots/neutral.png" "$tmp/skin.png"
+"$bin/afm-import" "$tmp/tex.wrl" "$tmp/head.fdp" -o "$tmp/tex.afm" --analytic >/dev/null || fail "afm-import of the textured head failed"
+"$export_tool" "$tmp/tex.afm" --gltf "$tmp/tex.glb" >"$tmp/out.txt" 2>&1 || fail "textured export failed: $(cat "$tmp/out.txt")"
+grep -q " 1 textures" "$tmp/out.txt" || fail "the texture is not embedded: $(cat "$tmp/out.txt")"
+node "$js/validate.cjs" "$tmp/tex.glb" >"$tmp/validate_tex.txt" 2>&1 || fail "tex.glb: $(cat "$tmp/validate_tex.txt")"
+
 # --- a real stream, when ../shared/data is there
 joy="${AFM_SHARED_DIR:-$top/../shared}/data/fap/xface/joy.fap"
 note=""

@@ -6,6 +6,7 @@
 // tests/cli/test_export.sh (Khronos validator, three.js in Chromium).
 #include <afm/mpeg4.h>
 #include <afm/player.h>
+#include <afm/render.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -258,6 +259,34 @@ TEST(ExportGltf, GlbContainerAndNames) {
   EXPECT_EQ(stats.meshes, doc.geometry.part_count);
   EXPECT_EQ(stats.frames, 0u);
   EXPECT_EQ(json.find("\"animations\""), std::string::npos) << "an animation without a stream";
+}
+
+// A part's PNG texture is embedded; a TGA one is left out with a note.
+TEST(ExportGltf, EmbedsPngTexturesOnly) {
+  afm_doc doc = reference_doc();  // a shallow copy whose part table we replace
+  ASSERT_NE(doc.geometry.u, nullptr) << "the reference head has no texture coordinates";
+  std::vector<afm_part> parts(doc.geometry.parts, doc.geometry.parts + doc.geometry.part_count);
+  parts[0].texture = "skin.png";
+  parts[1].texture = "eye.tga";
+  doc.geometry.parts = parts.data();
+  const std::string dir = afmtest::temp_dir("export_gltf_textures");
+  const std::vector<uint8_t> rgba(4 * 4 * 4, 200);
+  const afm_render_image image = {rgba.data(), 4, 4};
+  ASSERT_EQ(afm_png_write((dir + "/skin.png").c_str(), &image), AFM_OK);
+  std::ofstream(dir + "/eye.tga") << "not a PNG";
+  afmb::GltfOptions options;
+  options.texture_dirs = {dir};
+  std::vector<std::string> notes;
+  options.note = [&notes](const std::string &n) { notes.push_back(n); };
+  afmb::GltfStats stats;
+  afmb::Expected<std::vector<uint8_t>> glb = afmb::gltf_bytes(doc, "reference", options, &stats);
+  ASSERT_TRUE(glb) << glb.status().message();
+  EXPECT_EQ(stats.textures, 1u);
+  const std::string all(glb->begin(), glb->end());
+  EXPECT_NE(all.find("\"mimeType\":\"image/png\""), std::string::npos);
+  EXPECT_NE(all.find("\"baseColorTexture\":{\"index\":0}"), std::string::npos);
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("eye.tga is not PNG or JPEG"), std::string::npos) << notes[0];
 }
 
 TEST(JsonWriter, NestsEscapesAndRefusesNonFinite) {
