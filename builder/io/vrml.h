@@ -1,13 +1,13 @@
 // VRML97 scenes of named IndexedFaceSet parts: Xface, visage and Song models.
 //
 // Reads Transform / Group / Collision / Anchor / Billboard / Switch (the
-// chosen child) / LOD (the first level) / Shape / IndexedFaceSet /
-// Coordinate / TextureCoordinate / Color / Appearance / Material /
-// ImageTexture, DEF and USE, and nested Transforms (translation, rotation,
-// scale, scaleOrientation, center: P' = T C R SR S -SR -C P), applied to the
-// points. Every other node (PROTO instances included) is skipped whole, as
-// are PROTO, EXTERNPROTO and ROUTE statements and unknown fields. The file
-// must start with "#VRML V2.0".
+// chosen child, or every one with VrmlReadOptions) / LOD (the first level) /
+// Shape / IndexedFaceSet / Coordinate / TextureCoordinate / Color /
+// Appearance / Material / ImageTexture, DEF and USE, and nested Transforms
+// (translation, rotation, scale, scaleOrientation, center:
+// P' = T C R SR S -SR -C P), applied to the points. Every other node (PROTO
+// instances included) is skipped whole, as are PROTO, EXTERNPROTO and ROUTE
+// statements and unknown fields. The file must start with "#VRML V2.0".
 //
 // Each IndexedFaceSet instance becomes a part. Its name: the DEF of the
 // innermost DEF'd grouping node that holds no other mesh (Song:
