@@ -10,7 +10,14 @@ PACKAGES="
   libgtest-dev
   gcc-arm-linux-gnueabi libc6-dev-armel-cross qemu-user
   clang libclang-rt-14-dev
+  chromium
 "
+# Node.js for the export tests (tools/deps-npm.sh): Debian's nodejs and npm,
+# unless a node and npm are installed already (e.g. from another source,
+# whose packages Debian's npm would conflict with).
+if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
+  PACKAGES="$PACKAGES nodejs npm"
+fi
 
 missing=""
 for p in $PACKAGES; do
@@ -21,9 +28,10 @@ for p in $PACKAGES; do
   esac
 done
 
+npm_deps="$(dirname "$0")/deps-npm.sh"
 if [ -z "$missing" ]; then
   echo "deps: all packages present"
-  exit 0
+  exec sh "$npm_deps"
 fi
 
 echo "deps: installing$missing"
@@ -40,3 +48,4 @@ $SUDO apt-get update -qq
 # shellcheck disable=SC2086
 $SUDO apt-get install -y -qq --no-install-recommends $missing >/dev/null
 echo "deps: done"
+exec sh "$npm_deps"

@@ -480,6 +480,7 @@ struct Builder {
   std::string source;     // for messages
   std::string file_name;  // for "<file>_<N>" aliases
   Scene scene;
+  bool all_switch_choices = false;
   std::map<const Node *, int> ifs_count_memo;
 
   [[noreturn]] void fail(int line, const std::string &msg) const {
@@ -490,6 +491,7 @@ struct Builder {
     if (n.type == "Switch") {
       const Value *w = n.field("whichChoice");
       const Value *c = n.field("choice");
+      if (all_switch_choices) return c ? c->nodes : std::vector<NodePtr>{};
       int which = w && !w->nums.empty() ? static_cast<int>(w->nums[0]) : -1;
       if (!c || which < 0 || which >= static_cast<int>(c->nodes.size())) return {};
       return {c->nodes[which]};
@@ -803,7 +805,8 @@ std::string quoted(const std::string &s) {
 
 }  // namespace
 
-Expected<Scene> parse_vrml(std::string_view text, const std::string &source_name) {
+Expected<Scene> parse_vrml(std::string_view text, const std::string &source_name,
+                           const VrmlReadOptions &options) {
   try {
     // A UTF-8 byte order mark before the header is tolerated.
     if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);
@@ -816,6 +819,7 @@ Expected<Scene> parse_vrml(std::string_view text, const std::string &source_name
     std::vector<NodePtr> roots = parser.parse_file();
     Builder b;
     b.source = source_name;
+    b.all_switch_choices = options.all_switch_choices;
     b.file_name = base_name(source_name);
     b.scene.name = stem(source_name);
     b.scene.source = source_name;
@@ -829,30 +833,28 @@ Expected<Scene> parse_vrml(std::string_view text, const std::string &source_name
   }
 }
 
-Expected<Scene> read_vrml(const std::string &path) {
+Expected<Scene> read_vrml(const std::string &path, const VrmlReadOptions &options) {
   Expected<std::string> text = read_file(path);
   if (!text) return text.status();
-  Expected<Scene> s = parse_vrml(*text, path);
+  Expected<Scene> s = parse_vrml(*text, path, options);
   if (s) s->source = path;
   return s;
 }
 
-Status write_vrml(const Scene &scene, const std::string &path) {
+Expected<std::string> vrml_parts_text(const Scene &scene, std::set<std::string> *used,
+                                      const std::string &where) {
   std::string out;
   out.reserve(64 + scene.vertex_count() * 40 + scene.triangle_count() * 30);
-  out += "#VRML V2.0 utf8\n";
-  if (!scene.name.empty()) out += "# " + scene.name + "\n";
-  out += "\n";
-  std::set<std::string> used;  // DEF names must be unique in the file
-  auto unique_id = [&used](const std::string &name) {
+  // DEF names must be unique in the file.
+  auto unique_id = [used](const std::string &name) {
     std::string base = vrml_id(name), id = base;
-    for (int k = 2; used.count(id); ++k) id = base + "_" + std::to_string(k);
-    used.insert(id);
+    for (int k = 2; used->count(id); ++k) id = base + "_" + std::to_string(k);
+    used->insert(id);
     return id;
   };
   for (const Part &p : scene.parts) {
     if (p.V.cols() != 3 || p.F.cols() != 3 || (p.FTC.rows() > 0 && p.FTC.rows() != p.F.rows()))
-      return Status::error(path + ": part '" + p.name + "' has malformed matrices (V " +
+      return Status::error(where + ": part '" + p.name + "' has malformed matrices (V " +
                            std::to_string(p.V.rows()) + "x" + std::to_string(p.V.cols()) + ", F " +
                            std::to_string(p.F.rows()) + "x" + std::to_string(p.F.cols()) + ")");
     const std::string name = unique_id(p.name);
@@ -889,6 +891,19 @@ Status write_vrml(const Scene &scene, const std::string &path) {
     }
     out += "      }\n    }\n  ]\n}\n\n";
   }
+  return out;
+}
+
+std::string vrml_string(const std::string &text) { return quoted(text); }
+
+Status write_vrml(const Scene &scene, const std::string &path) {
+  std::string out = "#VRML V2.0 utf8\n";
+  if (!scene.name.empty()) out += "# " + scene.name + "\n";
+  out += "\n";
+  std::set<std::string> used;
+  Expected<std::string> parts = vrml_parts_text(scene, &used, path);
+  if (!parts) return parts.status();
+  out += *parts;
   return write_file_atomic(path, out);
 }
 

@@ -1,13 +1,13 @@
 // VRML97 scenes of named IndexedFaceSet parts: Xface, visage and Song models.
 //
 // Reads Transform / Group / Collision / Anchor / Billboard / Switch (the
-// chosen child) / LOD (the first level) / Shape / IndexedFaceSet /
-// Coordinate / TextureCoordinate / Color / Appearance / Material /
-// ImageTexture, DEF and USE, and nested Transforms (translation, rotation,
-// scale, scaleOrientation, center: P' = T C R SR S -SR -C P), applied to the
-// points. Every other node (PROTO instances included) is skipped whole, as
-// are PROTO, EXTERNPROTO and ROUTE statements and unknown fields. The file
-// must start with "#VRML V2.0".
+// chosen child, or every one with VrmlReadOptions) / LOD (the first level) /
+// Shape / IndexedFaceSet / Coordinate / TextureCoordinate / Color /
+// Appearance / Material / ImageTexture, DEF and USE, and nested Transforms
+// (translation, rotation, scale, scaleOrientation, center:
+// P' = T C R SR S -SR -C P), applied to the points. Every other node (PROTO
+// instances included) is skipped whole, as are PROTO, EXTERNPROTO and ROUTE
+// statements and unknown fields. The file must start with "#VRML V2.0".
 //
 // Each IndexedFaceSet instance becomes a part. Its name: the DEF of the
 // innermost DEF'd grouping node that holds no other mesh (Song:
@@ -35,6 +35,7 @@
 // geometry would be missing). A file without any IndexedFaceSet is an error.
 #pragma once
 
+#include <set>
 #include <string>
 #include <string_view>
 
@@ -43,9 +44,17 @@
 
 namespace afmb {
 
-Expected<Scene> read_vrml(const std::string &path);
+struct VrmlReadOptions {
+  // Read every choice of a Switch, not only the chosen one: for files that
+  // keep alternatives out of sight, such as the morph targets afm-export
+  // stores in a Switch with whichChoice -1 (formats/export.md).
+  bool all_switch_choices = false;
+};
+
+Expected<Scene> read_vrml(const std::string &path, const VrmlReadOptions &options = {});
 // `source_name` is used in messages and for the "<file>_<N>" aliases.
-Expected<Scene> parse_vrml(std::string_view text, const std::string &source_name);
+Expected<Scene> parse_vrml(std::string_view text, const std::string &source_name,
+                           const VrmlReadOptions &options = {});
 
 // Writes one DEF'd Transform + Shape + IndexedFaceSet per part, with Material,
 // ImageTexture and TextureCoordinate where the part has them, and per-vertex
@@ -55,5 +64,13 @@ Expected<Scene> parse_vrml(std::string_view text, const std::string &source_name
 // "<name>-FACES"); characters VRML forbids in names become '_' and repeated
 // names get "_2". Kinds and further aliases are not written. Atomic.
 Status write_vrml(const Scene &scene, const std::string &path);
+
+// The part nodes write_vrml writes (no header line), for writers that add
+// nodes of their own. `used` holds the DEF names already taken in the file
+// and gets the new ones. Errors (malformed matrices) name `where`.
+Expected<std::string> vrml_parts_text(const Scene &scene, std::set<std::string> *used,
+                                      const std::string &where);
+// A VRML SFString literal: quotes, with '"' and '\\' escaped.
+std::string vrml_string(const std::string &text);
 
 }  // namespace afmb

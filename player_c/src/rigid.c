@@ -122,6 +122,32 @@ static void apply(afm_player *p, const afm_rigid *r, const afm_rigid_transform *
   }
 }
 
+/* The rigid's transform for states a..b at t; returns 0 (and the exact
+ * identity) when no degree of freedom moves. */
+static int rigid_pose(const afm_rigid *r, const afm_fap_state *a, const afm_fap_state *b,
+                      afm_q16 t, afm_rigid_transform *x) {
+  int32_t motion[6];
+  int k;
+  rigid_motion(r, a, b, t, motion);
+  if (!motion[0] && !motion[1] && !motion[2] && !motion[3] && !motion[4] && !motion[5]) {
+    for (k = 0; k < 9; ++k) x->rotation[k] = (afm_q14)((k % 4 == 0) ? AFM_Q14_ONE : 0);
+    x->translation[0] = x->translation[1] = x->translation[2] = 0;
+    return 0;
+  }
+  rigid_transform(r, motion, x);
+  return 1;
+}
+
+afm_result afm_rigid_pose(const afm_rigid *rigid, const afm_fap_state *a, const afm_fap_state *b,
+                          afm_q16 t, afm_rigid_transform *out) {
+  static const afm_fap_state kNeutral; /* zero-initialised constant, not mutable state */
+  if (!rigid || !out || t < 0 || t > AFM_Q16_ONE) return AFM_ERR_ARGUMENT;
+  if (!a) a = &kNeutral;
+  if (!b) b = a, t = 0;
+  rigid_pose(rigid, a, b, t, out);
+  return AFM_OK;
+}
+
 void afm_rigids_apply(afm_player *p, const afm_fap_state *a, const afm_fap_state *b, afm_q16 t) {
   const afm_doc *doc = p->doc;
   uint32_t r;
@@ -132,12 +158,9 @@ void afm_rigids_apply(afm_player *p, const afm_fap_state *a, const afm_fap_state
   for (pass = 0; pass < 2; ++pass)
     for (r = 0; r < doc->rigid_count; ++r) {
       const afm_rigid *rg = &doc->rigids[r];
-      int32_t motion[6];
       afm_rigid_transform x;
       if ((rg->kind == AFM_RIGID_HEAD) != (pass == 1)) continue;
-      rigid_motion(rg, a, b, t, motion);
-      if (!motion[0] && !motion[1] && !motion[2] && !motion[3] && !motion[4] && !motion[5]) continue;
-      rigid_transform(rg, motion, &x);
+      if (!rigid_pose(rg, a, b, t, &x)) continue;
       if (rg->kind == AFM_RIGID_HEAD) {
         p->head = x;
         if (p->flags & AFM_PLAYER_HEAD_MATRIX) continue;

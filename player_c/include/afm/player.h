@@ -153,6 +153,18 @@ const afm_q12 *afm_player_weights(const afm_player *player);
  * flag the vertices already include it. */
 const afm_rigid_transform *afm_player_head_transform(const afm_player *player);
 
+/* The transform of one rigid part (an entry of doc->rigids) for state a
+ * blended toward b by t, exactly as afm_player_pose moves that part's
+ * vertices: the exact identity when none of its degrees of freedom moves.
+ * The jaw's and eyes' transforms act in the neutral frame; the head's acts
+ * after them (p' = H (E p)). For exporters that keep parts rigid and animate
+ * transforms instead of vertices. a NULL is the neutral state; b NULL is a
+ * alone. Use it on a model afm_player_init accepted (it checks the rigids'
+ * axes and pivots). AFM_ERR_ARGUMENT for a NULL rigid or out, or t outside
+ * [0, 65536]. No allocation. */
+afm_result afm_rigid_pose(const afm_rigid *rigid, const afm_fap_state *a, const afm_fap_state *b,
+                          afm_q16 t, afm_rigid_transform *out);
+
 #ifdef __cplusplus
 }
 #endif
