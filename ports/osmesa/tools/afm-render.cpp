@@ -1,9 +1,8 @@
 // afm-render: plays a FAP stream on an AFM with the fixed-point player and
 // renders the frames offscreen (OSMesa) to PNG files and a contact sheet.
-#include <afm/draco.h>
 #include <afm/fap_stream.h>
 #include <afm/format.h>
-#include <afm/image.h>
+#include <afm/face_scene.h>
 #include <afm/player.h>
 #include <afm/render.h>
 
@@ -97,9 +96,7 @@ void usage(FILE *out) {
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
-struct InputError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
+using afm_face::InputError;
 
 std::string lower(std::string s) {
   for (char &c : s) c = (char)std::tolower((unsigned char)c);
@@ -266,130 +263,6 @@ Options parse_args(int argc, char **argv, bool *help) {
   return o;
 }
 
-// ---- inputs ------------------------------------------------------------------
-
-struct DocFree {
-  void operator()(afm_doc *d) const { afm_free(nullptr, d); }
-};
-struct MallocFree {
-  void operator()(void *p) const { std::free(p); }
-};
-
-std::vector<uint8_t> read_whole(const std::string &path) {
-  uint8_t *data = nullptr;
-  size_t size = 0;
-  errno = 0;
-  const afm_result r = afm_file_read(path.c_str(), nullptr, &data, &size);
-  if (r != AFM_OK) {
-    const int e = errno;
-    std::error_code ec;
-    if (fs::is_directory(path, ec)) throw InputError(path + ": is a directory, not a file");
-    throw InputError(path + ": cannot read: " + (e ? std::strerror(e) : afm_result_string(r)));
-  }
-  std::vector<uint8_t> out(data, data + size);
-  afm_free(nullptr, data);
-  return out;
-}
-
-std::unique_ptr<afm_doc, DocFree> load_model(const std::string &path) {
-  const std::vector<uint8_t> bytes = read_whole(path);
-  afm_diag diag{};
-  afm_read_options ro{};
-  ro.draco = afm_draco_codec();
-  ro.diag = &diag;
-  afm_doc *doc = nullptr;
-  const afm_result r = afm_doc_read_alloc(bytes.data(), bytes.size(), &ro, nullptr, &doc);
-  if (r != AFM_OK)
-    throw InputError(path + ": " + (diag.message[0] ? diag.message : afm_result_string(r)));
-  std::unique_ptr<afm_doc, DocFree> d(doc);
-  if (doc->geometry.vertex_count == 0 || doc->geometry.triangle_count == 0)
-    throw InputError(path + ": the model has no triangles to draw");
-  return d;
-}
-
-struct Stream {
-  afm_fap_header header{};
-  afm_fap_stats stats{};
-  std::vector<afm_fap_frame> frames;
-};
-
-Stream load_stream(const std::string &path) {
-  const std::vector<uint8_t> bytes = read_whole(path);
-  Stream s;
-  afm_diag diag{};
-  uint32_t count = 0;
-  afm_result r = afm_fap_parse(bytes.data(), bytes.size(), nullptr, nullptr, 0, &count, nullptr,
-                               nullptr, &diag);
-  if (r == AFM_OK) {
-    if (count == 0) throw InputError(path + ": the stream has no frames");
-    s.frames.resize(count);
-    r = afm_fap_parse(bytes.data(), bytes.size(), nullptr, s.frames.data(), count, &count, &s.header,
-                      &s.stats, &diag);
-  }
-  if (r != AFM_OK) {
-    const std::string msg = diag.message[0] ? diag.message : afm_result_string(r);
-    // The reader's messages may already start with "line N:".
-    if (diag.line && msg.rfind("line ", 0) != 0)
-      throw InputError(path + ":" + std::to_string(diag.line) + ": " + msg);
-    if (diag.line)
-      throw InputError(path + ":" + std::to_string(diag.line) + ": " + msg.substr(msg.find(':') + 2));
-    throw InputError(path + ": " + msg);
-  }
-  s.frames.resize(count);
-  return s;
-}
-
-// The file a part's texture names: in --textures DIR, then beside the model;
-// an exact name first, then the same name in another case (models made on
-// case-insensitive file systems). Empty when not found.
-std::string find_texture(const std::string &name, const std::vector<fs::path> &dirs) {
-  std::error_code ec;
-  const fs::path n(name);
-  if (n.is_absolute()) return fs::is_regular_file(n, ec) ? n.string() : std::string();
-  for (const fs::path &d : dirs) {
-    const fs::path p = d / n;
-    if (fs::is_regular_file(p, ec)) return p.string();
-  }
-  const std::string want = lower(n.filename().string());
-  for (const fs::path &d : dirs) {
-    const fs::path sub = (d / n).parent_path();
-    if (!fs::is_directory(sub, ec)) continue;
-    for (fs::directory_iterator it(sub, ec), end; !ec && it != end; it.increment(ec))
-      if (lower(it->path().filename().string()) == want && fs::is_regular_file(it->path(), ec))
-        return it->path().string();
-  }
-  return {};
-}
-
-// Cut-out textures (hair, lashes) often hold white or black where they are
-// transparent, and filtering blends that into the edges of what is drawn: a
-// bright fringe. Transparent texels take the mean colour of the opaque ones.
-void fill_transparent(afm_image *im) {
-  const size_t n = (size_t)im->width * im->height;
-  double sum[3] = {0, 0, 0}, count = 0;
-  for (size_t i = 0; i < n; ++i) {
-    const uint8_t *p = im->rgba + i * 4;
-    if (p[3] < 128) continue;
-    for (int k = 0; k < 3; ++k) sum[k] += p[k];
-    count += 1;
-  }
-  if (count == 0) return;
-  for (size_t i = 0; i < n; ++i) {
-    uint8_t *p = im->rgba + i * 4;
-    if (p[3] >= 128) continue;
-    for (int k = 0; k < 3; ++k) p[k] = (uint8_t)std::lround(sum[k] / count);
-  }
-}
-
-// ---- timeline ------------------------------------------------------------------
-
-// Microseconds from frame 0 to render frame k at num/den frames per second,
-// rounded down exactly as the cursor times the stream's own frames.
-uint64_t frame_time_us(uint64_t k, uint32_t num, uint32_t den) {
-  const uint64_t ticks = k * den;
-  return ticks / num * 1000000u + ticks % num * 1000000u / num;
-}
-
 // ---- pictures ------------------------------------------------------------------
 
 std::vector<uint8_t> shrink(const std::vector<uint8_t> &rgba, int w, int h, int s, int *ow, int *oh) {
@@ -438,9 +311,9 @@ struct Renderer {
 
 int run(const Options &o) {
   // ---- the model and the stream
-  std::unique_ptr<afm_doc, DocFree> doc = load_model(o.model);
+  const afm_face::Doc doc = afm_face::load_model(o.model);
   const afm_geometry &g = doc->geometry;
-  Stream stream = load_stream(o.stream);
+  const afm_face::Stream stream = afm_face::load_stream(o.stream);
   const uint32_t fps_num = o.fps_num ? o.fps_num : stream.header.fps_num;
   const uint32_t fps_den = o.fps_num ? o.fps_den : stream.header.fps_den;
   if (fps_num == 0 || fps_den == 0) throw InputError(o.stream + ": line 1: the frame rate is 0");
@@ -452,8 +325,8 @@ int run(const Options &o) {
   const uint64_t duration_us = afm_fap_cursor_duration_us(&cursor);
   // Render frames 0..total-1: every time from 0 to the last frame's.
   uint64_t total = (uint64_t)((double)duration_us * fps_num / (1e6 * fps_den));
-  while (total > 0 && frame_time_us(total, fps_num, fps_den) > duration_us) --total;
-  while (frame_time_us(total + 1, fps_num, fps_den) <= duration_us) ++total;
+  while (total > 0 && afm_face::frame_time_us(total, fps_num, fps_den) > duration_us) --total;
+  while (afm_face::frame_time_us(total + 1, fps_num, fps_den) <= duration_us) ++total;
   ++total;
   if (total > 100000000u) throw InputError(o.stream + ": more than 100000000 frames to render");
 
@@ -502,49 +375,15 @@ int run(const Options &o) {
   else
     to_render.assign(sheet_set.begin(), sheet_set.end());
 
-  // ---- textures
-  std::vector<fs::path> tex_dirs;
-  if (!o.textures_dir.empty()) {
-    std::error_code ec;
-    if (!fs::is_directory(o.textures_dir, ec))
-      throw InputError("--textures " + o.textures_dir + ": not a directory");
-    tex_dirs.push_back(o.textures_dir);
-  }
-  {
-    fs::path beside = fs::path(o.model).parent_path();
-    tex_dirs.push_back(beside.empty() ? fs::path(".") : beside);
-  }
-  struct Texture {
-    afm_image image{};
-    afm_render_image view{};
-    ~Texture() { afm_image_free(&image); }
-  };
-  std::map<std::string, std::unique_ptr<Texture>> textures;  // by file path
-  std::vector<const Texture *> part_texture(g.part_count, nullptr);
-  const bool have_uvs = g.u && g.v && (g.attributes & AFM_ATTR_TEXCOORDS);
-  if (have_uvs && !o.no_textures) {
-    for (uint32_t p = 0; p < g.part_count; ++p) {
-      const afm_part &part = g.parts[p];
-      if (!part.texture || !part.texture[0] || part.triangle_count == 0) continue;
-      const std::string file = find_texture(part.texture, tex_dirs);
-      if (file.empty()) {
-        std::string where;
-        for (const fs::path &d : tex_dirs) where += (where.empty() ? "" : " or ") + d.string();
-        throw InputError(o.model + ": part " + part.name + ": texture '" + part.texture +
-                         "' is not in " + where + " (give --textures DIR, or --no-textures)");
-      }
-      auto it = textures.find(file);
-      if (it == textures.end()) {
-        auto t = std::make_unique<Texture>();
-        if (afm_image_read(file.c_str(), &t->image) != AFM_OK)
-          throw InputError(std::string(afm_render_last_error()) + " (texture of part " + part.name + ")");
-        if (t->image.has_alpha) fill_transparent(&t->image);
-        t->view = {t->image.rgba, t->image.width, t->image.height};
-        it = textures.emplace(file, std::move(t)).first;
-      }
-      part_texture[p] = it->second.get();
-    }
-  }
+  // ---- the model's meshes, textures, player and framing
+  afm_face::FaceOptions fo;
+  fo.model_path = o.model;
+  fo.textures_dir = o.textures_dir;
+  fo.no_textures = o.no_textures;
+  fo.flip_v = o.flip_v;
+  fo.closeup = o.closeup;
+  afm_face::FaceScene face;
+  afm_face::init_face(face, *doc, fo);
 
   // ---- output places, checked before any work
   Written written;
@@ -565,59 +404,6 @@ int run(const Options &o) {
       throw InputError(o.sheet + ": the directory " + parent.string() + " does not exist");
   }
 
-  // ---- the player
-  afm_player_options po{};
-  size_t player_bytes = 0;
-  res = afm_player_measure(doc.get(), &po, &player_bytes);
-  std::unique_ptr<void, MallocFree> player_memory;
-  if (res == AFM_OK) {
-    player_memory.reset(std::malloc(player_bytes ? player_bytes : 1));
-    if (!player_memory) res = AFM_ERR_OUT_OF_MEMORY;
-  }
-  afm_player *player = nullptr;
-  if (res == AFM_OK) res = afm_player_init(doc.get(), &po, player_memory.get(), player_bytes, &player);
-  if (res != AFM_OK) throw InputError(o.model + ": cannot play: " + afm_result_string(res));
-
-  // ---- meshes: one per part over shared vertex arrays (triangles index the
-  // whole vertex list)
-  const size_t V = g.vertex_count;
-  std::vector<float> pos(V * 3), nrm(V * 3), uvs;
-  if (have_uvs) {
-    uvs.resize(V * 2);
-    for (size_t v = 0; v < V; ++v) {
-      uvs[v * 2] = (float)(g.uv_origin[0] + (double)g.u[v] * g.uv_step[0]);
-      const double tv = g.uv_origin[1] + (double)g.v[v] * g.uv_step[1];
-      uvs[v * 2 + 1] = (float)(o.flip_v ? 1.0 - tv : tv);
-    }
-  }
-  std::vector<afm_render_mesh> meshes;
-  size_t textured_parts = 0;
-  for (uint32_t p = 0; p < g.part_count; ++p) {
-    const afm_part &part = g.parts[p];
-    if (part.triangle_count == 0) continue;
-    afm_render_mesh m{};
-    m.positions = pos.data();
-    m.vertex_count = V;
-    m.triangles = g.triangles + (size_t)part.first_triangle * 3;
-    m.triangle_count = part.triangle_count;
-    m.normals = nrm.data();
-    const bool colours = g.rgba && (g.attributes & AFM_ATTR_COLORS);
-    m.colors = colours ? g.rgba : nullptr;
-    if (part_texture[p]) {
-      // VRML: a texture replaces the diffuse colour (vertex colours still modulate).
-      m.uvs = uvs.data();
-      m.texture = &part_texture[p]->view;
-      m.texture_static = 1;  // loaded once, never changed
-      for (int k = 0; k < 4; ++k) m.color[k] = 1.0f;
-      if (part_texture[p]->image.has_alpha) m.alpha_cutoff = 0.5f;
-      ++textured_parts;
-    } else {
-      for (int k = 0; k < 4; ++k) m.color[k] = part.diffuse[k] / 255.0f;
-      m.color[3] = 1.0f;
-    }
-    meshes.push_back(m);
-  }
-
   // ---- the camera: framed once on the neutral model (or its face)
   afm_render_view view;
   afm_render_view_init(&view, o.width, o.height);
@@ -626,31 +412,7 @@ int run(const Options &o) {
   view.fov_deg = o.fov;
   view.supersample = o.aa;
   std::memcpy(view.background, o.background, 4);
-  {
-    float lo[3] = {1e30f, 1e30f, 1e30f}, hi[3] = {-1e30f, -1e30f, -1e30f};
-    if (o.closeup) {
-      for (uint32_t i = 0; i < doc->meta.fdp_count; ++i) {
-        const afm_fdp_point &f = doc->meta.fdps[i];
-        if (f.group == 7 || f.group == 10 || f.group == 11) continue;  // spine, ears, skull
-        for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], f.pos[k]), hi[k] = std::max(hi[k], f.pos[k]);
-      }
-      if (lo[0] > hi[0] || hi[1] - lo[1] <= 0)
-        throw InputError(o.model + ": --closeup frames the face by its FDPs, and the model has none");
-      // Room around the features, more above them for the forehead.
-      const float pad = 0.15f * (hi[1] - lo[1]);
-      for (int k = 0; k < 3; ++k) lo[k] -= pad, hi[k] += pad;
-      hi[1] += 2 * pad;
-    } else {
-      const int16_t *q[3] = {g.px, g.py, g.pz};
-      for (size_t v = 0; v < V; ++v)
-        for (int k = 0; k < 3; ++k) {
-          const float x = (float)(g.origin[k] + (double)q[k][v] * g.step);
-          lo[k] = std::min(lo[k], x);
-          hi[k] = std::max(hi[k], x);
-        }
-    }
-    for (int k = 0; k < 3; ++k) view.box_min[k] = lo[k], view.box_max[k] = hi[k];
-  }
+  for (int k = 0; k < 3; ++k) view.box_min[k] = face.box_min[k], view.box_max[k] = face.box_max[k];
 
   if (!o.quiet) {
     std::printf("%s: %zu frames at %lu/%lu fps (%.3f s); rendering %zu frame(s) at %s (%s, frames %ld to %ld)\n",
@@ -658,8 +420,8 @@ int run(const Options &o) {
                 (unsigned long)stream.header.fps_den, (double)duration_us * 1e-6, to_render.size(),
                 rate, o.fps_num ? "resampled" : "the stream's rate", first, last);
     std::printf("%s: %lu vertices, %lu triangles, %lu parts (%zu textured, %zu texture files%s)\n",
-                o.model.c_str(), (unsigned long)V, (unsigned long)g.triangle_count,
-                (unsigned long)g.part_count, textured_parts, textures.size(),
+                o.model.c_str(), (unsigned long)g.vertex_count, (unsigned long)g.triangle_count,
+                (unsigned long)g.part_count, face.textured_parts, face.textures.size(),
                 g.rgba ? ", vertex colours" : "");
     std::fflush(stdout);
   }
@@ -675,20 +437,13 @@ int run(const Options &o) {
     auto t0 = std::chrono::steady_clock::now();
     const afm_fap_state *a = nullptr, *b = nullptr;
     afm_q16 t = 0;
-    res = afm_fap_cursor_seek(&cursor, frame_time_us((uint64_t)f, fps_num, fps_den), &a, &b, &t);
-    if (res == AFM_OK) res = afm_player_pose(player, a, b, t);
+    res = afm_fap_cursor_seek(&cursor, afm_face::frame_time_us((uint64_t)f, fps_num, fps_den), &a, &b, &t);
+    if (res == AFM_OK) res = afm_face::pose_face(face, a, b, t);
     if (res != AFM_OK)
       throw InputError("frame " + std::to_string(f) + ": the player fails: " + afm_result_string(res));
-    const int32_t *x = afm_player_positions(player);
-    const afm_q14 *n = afm_player_normals(player);
-    for (size_t i = 0; i < V; ++i)
-      for (int k = 0; k < 3; ++k) {
-        pos[i * 3 + (size_t)k] = (float)(g.origin[k] + (double)x[i * 3 + (size_t)k] * g.step);
-        nrm[i * 3 + (size_t)k] = (float)n[i * 3 + (size_t)k] * (1.0f / 16384.0f);
-      }
     t_pose += ms_since(t0);
     t0 = std::chrono::steady_clock::now();
-    if (afm_renderer_draw(renderer.r, meshes.data(), meshes.size(), &view, rgba.data()) != AFM_OK)
+    if (afm_renderer_draw(renderer.r, face.meshes.data(), face.meshes.size(), &view, rgba.data()) != AFM_OK)
       throw InputError("frame " + std::to_string(f) + ": " + afm_render_last_error());
     t_draw += ms_since(t0);
     t0 = std::chrono::steady_clock::now();
