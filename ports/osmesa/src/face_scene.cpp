@@ -3,9 +3,9 @@
 
 #include <afm/draco.h>
 #include <afm/fap_stream.h>
+#include <afm/view_options.h>
 
 #include <algorithm>
-#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -17,11 +17,6 @@ namespace fs = std::filesystem;
 namespace afm_face {
 
 namespace {
-
-std::string lower(std::string s) {
-  for (char &c : s) c = (char)std::tolower((unsigned char)c);
-  return s;
-}
 
 // The file a part's texture names: in the textures directory, then beside
 // the model; an exact name first, then the same name in another case (models

@@ -3,6 +3,7 @@
 #include <afm/fap_stream.h>
 #include <afm/format.h>
 #include <afm/face_scene.h>
+#include <afm/view_options.h>
 #include <afm/player.h>
 #include <afm/render.h>
 
@@ -57,29 +58,9 @@ void usage(FILE *out) {
       "  --sheet-columns N     tiles per row (default: up to 6)\n"
       "  --sheet-shrink N      tiles N times smaller than the frames (default 1)\n"
       "\n"
-      "Camera and look\n"
-      "  --yaw DEG             turn the camera toward the face's left (+) or right (-)\n"
-      "  --pitch DEG           raise the camera (+) and look down\n"
-      "  --closeup             frame the face (its FDPs, without ears and hair)\n"
-      "                        instead of the whole neutral model\n"
-      "  --fov DEG             vertical field of view, 5..90 (default 25); 0 draws\n"
-      "                        an orthographic view\n"
-      "  --aa N                supersampling, 1..4 (default 2)\n"
-      "  --background R,G,B    background colour, 0..255 each (default 96,96,96)\n"
-      "  --textures DIR        look for texture files here first, then beside MODEL\n"
-      "  --no-textures         ignore textures: diffuse or vertex colours only\n"
-      "  --flip-v              turn textures upside down (v becomes 1 - v): for models\n"
-      "                        whose images are stored the other way up from what their\n"
-      "                        texture coordinates expect (VRML: v = 0 is the image's\n"
-      "                        bottom row), such as Song's TGA files\n"
-      "\n"
-      "The camera is framed once, on the neutral model's bounding box (or its face\n"
-      "with --closeup), so every frame of a run, and runs with the same options, are\n"
-      "directly comparable.\n"
-      "\n"
-      "Playing\n"
-      "  --mirror LIST         copy one-sided FAPs to the other side: lr (left/right),\n"
-      "                        io (inner/outer lip) or lr,io; off by default\n"
+      );
+  std::fputs(afm_face::kViewOptionsHelp, out);
+  std::fputs(
       "\n"
       "Other\n"
       "  --progress N          a progress line on stderr every N frames (default 25;\n"
@@ -89,66 +70,25 @@ void usage(FILE *out) {
       "\n"
       "Every PNG is written completely or not at all; when a run fails, the frames it\n"
       "wrote are removed. Exit status: 0 on success, 1 on bad input (the message names\n"
-      "the file and line, part or field) or a failed write, 2 on bad usage.\n");
+      "the file and line, part or field) or a failed write, 2 on bad usage.\n", out);
 }
 
 // Exit 2: the command line is wrong. Exit 1: an input is bad or a write failed.
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
 using afm_face::InputError;
-
-std::string lower(std::string s) {
-  for (char &c : s) c = (char)std::tolower((unsigned char)c);
-  return s;
-}
-
-long parse_long(const std::string &opt, const char *s, long lo, long hi) {
-  char *end = nullptr;
-  errno = 0;
-  const long v = std::strtol(s, &end, 10);
-  if (errno || end == s || *end || v < lo || v > hi)
-    throw UsageError(opt + ": expected a whole number from " + std::to_string(lo) + " to " +
-                     std::to_string(hi) + ", got '" + s + "'");
-  return v;
-}
-
-double parse_double(const std::string &opt, const char *s, double lo, double hi) {
-  char *end = nullptr;
-  errno = 0;
-  const double v = std::strtod(s, &end);
-  if (errno || end == s || *end || !std::isfinite(v) || v < lo || v > hi) {
-    char buf[160];
-    std::snprintf(buf, sizeof buf, ": expected a number from %g to %g, got '", lo, hi);
-    throw UsageError(opt + buf + s + "'");
-  }
-  return v;
-}
-
-std::vector<std::string> split(const std::string &s, char sep) {
-  std::vector<std::string> out;
-  size_t start = 0;
-  for (;;) {
-    const size_t p = s.find(sep, start);
-    out.push_back(s.substr(start, p == std::string::npos ? std::string::npos : p - start));
-    if (p == std::string::npos) break;
-    start = p + 1;
-  }
-  return out;
-}
+using afm_face::UsageError;
+using afm_face::lower;
+using afm_face::parse_double;
+using afm_face::parse_long;
+using afm_face::split;
 
 struct Options {
-  std::string model, stream, out_dir, sheet, textures_dir;
-  int width = 640, height = 480;
+  std::string model, stream, out_dir, sheet;
+  afm_face::ViewOptions view;  // --size, camera, look, --mirror
   long first = 0, last = -1;  // -1: to the end
   uint32_t fps_num = 0, fps_den = 1;  // 0: the stream's rate
   std::vector<long> sheet_frames;
   long sheet_every = 0, sheet_columns = 0, sheet_shrink = 1;
-  float yaw = 0, pitch = 0, fov = 25;
-  bool closeup = false, no_textures = false, quiet = false, flip_v = false;
-  int aa = 2;
-  uint8_t background[4] = {96, 96, 96, 255};
-  uint32_t mirror = 0;
+  bool quiet = false;
   long progress = 25;
 };
 
@@ -162,18 +102,14 @@ Options parse_args(int argc, char **argv, bool *help) {
       if (i + 1 >= argc) throw UsageError(a + " needs a value");
       return argv[++i];
     };
-    if (a == "--help" || a == "-h") {
+    if (afm_face::parse_view_option(a, value, o.view)) {
+      continue;
+    } else if (a == "--help" || a == "-h") {
       *help = true;
       return o;
     } else if (a == "-o" || a == "--output") {
       o.out_dir = value();
       if (o.out_dir.empty()) throw UsageError(a + ": empty directory name");
-    } else if (a == "--size") {
-      const std::string v = value();
-      const size_t x = v.find_first_of("xX");
-      if (x == std::string::npos) throw UsageError("--size: expected WxH (e.g. 640x480), got '" + v + "'");
-      o.width = (int)parse_long("--size: width (WxH)", v.substr(0, x).c_str(), 16, 4096);
-      o.height = (int)parse_long("--size: height (WxH)", v.substr(x + 1).c_str(), 16, 4096);
     } else if (a == "--frames") {
       const std::string v = value();
       const size_t c = v.find(':');
@@ -210,35 +146,6 @@ Options parse_args(int argc, char **argv, bool *help) {
       o.sheet_columns = parse_long(a, value(), 1, 100);
     } else if (a == "--sheet-shrink") {
       o.sheet_shrink = parse_long(a, value(), 1, 16);
-    } else if (a == "--yaw") {
-      o.yaw = (float)parse_double(a, value(), -360, 360);
-    } else if (a == "--pitch") {
-      o.pitch = (float)parse_double(a, value(), -89, 89);
-    } else if (a == "--fov") {
-      o.fov = (float)parse_double(a, value(), 0, 90);
-      if (o.fov > 0 && o.fov < 5) throw UsageError("--fov: 0 (orthographic) or 5..90 degrees");
-    } else if (a == "--closeup") {
-      o.closeup = true;
-    } else if (a == "--aa") {
-      o.aa = (int)parse_long(a, value(), 1, 4);
-    } else if (a == "--background") {
-      const std::string v = value();
-      const std::vector<std::string> parts = split(v, ',');
-      if (parts.size() != 3) throw UsageError("--background: expected R,G,B (0..255 each), got '" + v + "'");
-      for (int k = 0; k < 3; ++k)
-        o.background[k] = (uint8_t)parse_long("--background (R,G,B)", parts[(size_t)k].c_str(), 0, 255);
-    } else if (a == "--textures") {
-      o.textures_dir = value();
-    } else if (a == "--no-textures") {
-      o.no_textures = true;
-    } else if (a == "--flip-v") {
-      o.flip_v = true;
-    } else if (a == "--mirror") {
-      const std::string m = value();
-      if (m == "lr") o.mirror = AFM_MIRROR_LEFT_RIGHT;
-      else if (m == "io") o.mirror = AFM_MIRROR_INNER_OUTER;
-      else if (m == "lr,io" || m == "io,lr") o.mirror = AFM_MIRROR_LEFT_RIGHT | AFM_MIRROR_INNER_OUTER;
-      else throw UsageError("--mirror '" + m + "': use lr, io or lr,io");
     } else if (a == "--progress") {
       o.progress = parse_long(a, value(), 0, 100000000);
     } else if (a == "--quiet") {
@@ -320,7 +227,7 @@ int run(const Options &o) {
 
   afm_fap_cursor cursor;
   afm_result res = afm_fap_cursor_init(&cursor, stream.frames.data(), (uint32_t)stream.frames.size(),
-                                       stream.header.fps_num, stream.header.fps_den, o.mirror);
+                                       stream.header.fps_num, stream.header.fps_den, o.view.mirror);
   if (res != AFM_OK) throw InputError(o.stream + ": cannot play: " + afm_result_string(res));
   const uint64_t duration_us = afm_fap_cursor_duration_us(&cursor);
   // Render frames 0..total-1: every time from 0 to the last frame's.
@@ -362,7 +269,7 @@ int run(const Options &o) {
     const long n = (long)sheet_set.size();
     const long cols = o.sheet_columns ? std::min<long>(o.sheet_columns, n) : std::min<long>(6, n);
     const long rows = (n + cols - 1) / cols;
-    const long tw = o.width / o.sheet_shrink, th = o.height / o.sheet_shrink;
+    const long tw = o.view.width / o.sheet_shrink, th = o.view.height / o.sheet_shrink;
     if (tw < 1 || th < 1) throw UsageError("--sheet-shrink: tiles would be smaller than a pixel");
     if (cols * (tw + 4) + 4 > 65535 || rows * (th + 4) + 4 > 65535)
       throw UsageError("--sheet: " + std::to_string(n) + " tiles of " + std::to_string(tw) + "x" +
@@ -376,14 +283,8 @@ int run(const Options &o) {
     to_render.assign(sheet_set.begin(), sheet_set.end());
 
   // ---- the model's meshes, textures, player and framing
-  afm_face::FaceOptions fo;
-  fo.model_path = o.model;
-  fo.textures_dir = o.textures_dir;
-  fo.no_textures = o.no_textures;
-  fo.flip_v = o.flip_v;
-  fo.closeup = o.closeup;
   afm_face::FaceScene face;
-  afm_face::init_face(face, *doc, fo);
+  afm_face::init_face(face, *doc, afm_face::face_options(o.view, o.model));
 
   // ---- output places, checked before any work
   Written written;
@@ -405,14 +306,7 @@ int run(const Options &o) {
   }
 
   // ---- the camera: framed once on the neutral model (or its face)
-  afm_render_view view;
-  afm_render_view_init(&view, o.width, o.height);
-  view.yaw_deg = o.yaw;
-  view.pitch_deg = o.pitch;
-  view.fov_deg = o.fov;
-  view.supersample = o.aa;
-  std::memcpy(view.background, o.background, 4);
-  for (int k = 0; k < 3; ++k) view.box_min[k] = face.box_min[k], view.box_max[k] = face.box_max[k];
+  const afm_render_view view = afm_face::make_view(o.view, face, o.view.width, o.view.height);
 
   if (!o.quiet) {
     std::printf("%s: %zu frames at %lu/%lu fps (%.3f s); rendering %zu frame(s) at %s (%s, frames %ld to %ld)\n",
@@ -428,7 +322,7 @@ int run(const Options &o) {
 
   // ---- render
   Renderer renderer;
-  std::vector<uint8_t> rgba((size_t)o.width * o.height * 4);
+  std::vector<uint8_t> rgba((size_t)o.view.width * o.view.height * 4);
   std::vector<std::vector<uint8_t>> sheet_tiles;
   double t_pose = 0, t_draw = 0, t_png = 0;
   const auto t_start = std::chrono::steady_clock::now();
@@ -451,7 +345,7 @@ int run(const Options &o) {
       char name[32];
       std::snprintf(name, sizeof name, "frame_%05ld.png", f);
       const std::string path = (fs::path(o.out_dir) / name).string();
-      const afm_render_image im = {rgba.data(), o.width, o.height};
+      const afm_render_image im = {rgba.data(), o.view.width, o.view.height};
       if (afm_png_write(path.c_str(), &im) != AFM_OK) throw InputError(afm_render_last_error());
       written.files.push_back(path);
     }
@@ -471,10 +365,10 @@ int run(const Options &o) {
   if (!o.sheet.empty()) {
     std::vector<std::vector<uint8_t>> small;
     std::vector<afm_render_image> tiles;
-    int tw = o.width, th = o.height;
+    int tw = o.view.width, th = o.view.height;
     for (const std::vector<uint8_t> &tile : sheet_tiles) {
       if (o.sheet_shrink > 1) {
-        small.push_back(shrink(tile, o.width, o.height, (int)o.sheet_shrink, &tw, &th));
+        small.push_back(shrink(tile, o.view.width, o.view.height, (int)o.sheet_shrink, &tw, &th));
         tiles.push_back({small.back().data(), tw, th});
       } else {
         tiles.push_back({tile.data(), tw, th});
@@ -491,13 +385,13 @@ int run(const Options &o) {
   if (!o.quiet) {
     const double n = (double)std::max<size_t>(done, 1);
     if (!o.out_dir.empty())
-      std::printf("wrote %zu frame(s) of %dx%d to %s (frame_%05ld.png to frame_%05ld.png)\n", done, o.width,
-                  o.height, o.out_dir.c_str(), first, last);
+      std::printf("wrote %zu frame(s) of %dx%d to %s (frame_%05ld.png to frame_%05ld.png)\n", done, o.view.width,
+                  o.view.height, o.out_dir.c_str(), first, last);
     if (!o.sheet.empty())
       std::printf("wrote %s: %zu frame(s), %d per row, %dx%d\n", o.sheet.c_str(), sheet_tiles.size(), columns,
                   sheet_w, sheet_h);
     std::printf("time per frame: pose %.2f ms, render %.1f ms, PNG %.1f ms (%dx%d, %dx supersampled)\n",
-                t_pose / n, t_draw / n, t_png / n, o.width, o.height, o.aa);
+                t_pose / n, t_draw / n, t_png / n, o.view.width, o.view.height, o.view.aa);
     if (stream.stats.clamped)
       std::printf("note: %s: %lu value(s) outside their FAP's range were clamped\n", o.stream.c_str(),
                   (unsigned long)stream.stats.clamped);
