@@ -88,7 +88,9 @@ void usage(FILE *out) {
       "                        by --aa)\n"
       "  --frames N            frames to draw before the screenshot and --exit\n"
       "                        (default 1)\n"
-      "  --exit                close after those frames; prints the last title\n"
+      "  --exit                close after those frames; prints the last title. The\n"
+      "                        clock then moves one stream frame per drawn frame\n"
+      "                        (times --speed), so scripted runs repeat exactly\n"
       "\n",
       out);
   std::fputs(kKeysHelp, out);
@@ -629,13 +631,13 @@ void advance(Viewer &v, double dt) {
   v.clock_s += dt * v.speed;
   long f = (long)std::floor(v.clock_s * stream_fps(v) + 1e-9);
   if (f >= v.frame_count) {
-    if (v.loop) {
-      v.clock_s = std::fmod(v.clock_s, (double)v.frame_count / stream_fps(v));
-      f = (long)std::floor(v.clock_s * stream_fps(v) + 1e-9) % v.frame_count;
-    } else {
-      f = v.frame_count - 1;
-      v.playing = false;
-    }
+    // Looping: the last frame shows for one frame's time, then frame 0.
+    v.clock_s = std::fmod(v.clock_s, (double)v.frame_count / stream_fps(v));
+    f = (long)std::floor(v.clock_s * stream_fps(v) + 1e-9) % v.frame_count;
+  }
+  if (!v.loop && f >= v.frame_count - 1) {
+    f = v.frame_count - 1;  // the end: nothing after the last frame
+    v.playing = false;
   }
   if (f != v.frame) {
     v.frame = f;
@@ -749,7 +751,9 @@ int run(const Options &o) {
   double last = glfwGetTime();
   while (!v.quit && !glfwWindowShouldClose(v.window)) {
     const double now = glfwGetTime();
-    advance(v, now - last);
+    // Scripted runs repeat exactly: their clock moves one stream frame per
+    // drawn frame (times the speed).
+    advance(v, o.exit_after ? (v.has_stream ? 1.0 / stream_fps(v) : 0.0) : now - last);
     last = now;
     if (v.dirty) update_pose(v);
     const std::string t = title(v);
