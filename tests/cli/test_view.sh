@@ -26,19 +26,10 @@ done
 "$bin/afm-headgen" --vertices 1000 -o "$tmp/head.wrl" --fdp "$tmp/head.fdp" >/dev/null || fail "afm-headgen failed"
 "$bin/afm-import" "$tmp/head.wrl" "$tmp/head.fdp" -o "$tmp/head.afm" --analytic >/dev/null ||
   fail "afm-import failed"
-mask() {
-  printf '0 0 1'
-  i=4
-  while [ $i -le 68 ]; do
-    printf ' 0'
-    i=$((i + 1))
-  done
-  printf '\n'
-}
 {
   printf '2.1 cli 25 2\n'
-  mask; printf '0 0\n'
-  mask; printf '1 600\n'
+  mask_fap3; printf '0 0\n'
+  mask_fap3; printf '1 600\n'
 } >"$tmp/jaw.fap"
 model="$tmp/head.afm"
 stream="$tmp/jaw.fap"
@@ -60,7 +51,7 @@ cp "$tmp/head.wrl" "$tmp/not.afm"
 expect_error "not an AFM" 1 "not\.afm: " "$o" -- "$view" "$tmp/not.afm" --screenshot "$o" --exit
 {
   printf '2.1 cli 25 3\n'
-  mask; printf '0 0\n'
+  mask_fap3; printf '0 0\n'
   printf '0 0 1 0\n'
   printf '1 500\n'
 } >"$tmp/bad.fap"

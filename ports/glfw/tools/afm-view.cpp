@@ -788,7 +788,7 @@ extern "C" const char *__lsan_default_suppressions(void) {
 }
 
 int main(int argc, char **argv) {
-  try {
+  return afm_face::run_tool("afm-view", [&] {
     bool help = false;
     const Options o = parse_args(argc, argv, &help);
     if (help) {
@@ -796,14 +796,5 @@ int main(int argc, char **argv) {
       return 0;
     }
     return run(o);
-  } catch (const UsageError &e) {
-    std::fprintf(stderr, "afm-view: %s\n(afm-view --help lists the options and keys)\n", e.what());
-    return 2;
-  } catch (const InputError &e) {
-    std::fprintf(stderr, "afm-view: %s\n", e.what());
-    return 1;
-  } catch (const std::bad_alloc &) {
-    std::fprintf(stderr, "afm-view: out of memory\n");
-    return 1;
-  }
+  });
 }

@@ -9,12 +9,28 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <new>
 
 namespace afm_face {
 
 std::string lower(std::string s) {
   for (char &c : s) c = (char)std::tolower((unsigned char)c);
   return s;
+}
+
+int run_tool(const char *name, const std::function<int()> &body) {
+  try {
+    return body();
+  } catch (const UsageError &e) {
+    std::fprintf(stderr, "%s: %s\n(%s --help lists the options)\n", name, e.what(), name);
+    return 2;
+  } catch (const InputError &e) {
+    std::fprintf(stderr, "%s: %s\n", name, e.what());
+    return 1;
+  } catch (const std::bad_alloc &) {
+    std::fprintf(stderr, "%s: out of memory\n", name);
+    return 1;
+  }
 }
 
 long parse_long(const std::string &opt, const char *s, long lo, long hi) {

@@ -402,7 +402,7 @@ int run(const Options &o) {
 }  // namespace
 
 int main(int argc, char **argv) {
-  try {
+  return afm_face::run_tool("afm-render", [&] {
     bool help = false;
     const Options o = parse_args(argc, argv, &help);
     if (help) {
@@ -410,14 +410,5 @@ int main(int argc, char **argv) {
       return 0;
     }
     return run(o);
-  } catch (const UsageError &e) {
-    std::fprintf(stderr, "afm-render: %s\n(afm-render --help lists the options)\n", e.what());
-    return 2;
-  } catch (const InputError &e) {
-    std::fprintf(stderr, "afm-render: %s\n", e.what());
-    return 1;
-  } catch (const std::bad_alloc &) {
-    std::fprintf(stderr, "afm-render: out of memory\n");
-    return 1;
-  }
+  });
 }

@@ -19,6 +19,11 @@ struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// A tool's main: runs `body` and returns its exit status; a UsageError
+// prints "NAME: message" and the --help hint and gives 2, an InputError or
+// lack of memory prints "NAME: message" and gives 1.
+int run_tool(const char *name, const std::function<int()> &body);
+
 // A whole number in lo..hi; UsageError naming `opt` otherwise.
 long parse_long(const std::string &opt, const char *s, long lo, long hi);
 // A finite number in lo..hi; UsageError naming `opt` otherwise.
