@@ -75,7 +75,8 @@ C_LINK_LIBS := $(if $(PLAYER_SRC),$(PLAYER_LIB)) $(DRACO_LIB) $(FORMAT_LIB) -ldr
 # The desktop preview draws through GLFW's libGL, never libOSMesa: both define
 # the gl* functions. From libafm_render it takes the GL drawing (gl_draw.c),
 # the face scene and the PNG writer; not render.c, which would need OSMesa.
-GLFW_LINK_LIBS := $(RENDER_LIB) $(PLAYER_LIB) $(DRACO_LIB) $(FORMAT_LIB) -ldraco -lglfw -lGL -lpng -lm
+GLFW_LIBS := $(RENDER_LIB) $(PLAYER_LIB) $(DRACO_LIB) $(FORMAT_LIB)
+GLFW_LINK_LIBS := $(GLFW_LIBS) -ldraco -lglfw -lGL -lpng -lm
 
 # ---- tools -----------------------------------------------------------------
 C_TOOLS := $(patsubst formats/tools/%.c,$(B)/bin/%,$(wildcard formats/tools/*.c)) \
@@ -137,7 +138,7 @@ $(B)/bin/%: $(B)/obj/ports/osmesa/tools/%.cpp.o $(LIBS)
 	@mkdir -p $(@D)
 	$(CXX) $< -o $@ $(LDFLAGS) $(CXX_LINK_LIBS)
 
-$(B)/bin/%: $(B)/obj/ports/glfw/tools/%.cpp.o $(LIBS)
+$(B)/bin/%: $(B)/obj/ports/glfw/tools/%.cpp.o $(GLFW_LIBS)
 	@mkdir -p $(@D)
 	$(CXX) $< -o $@ $(LDFLAGS) $(GLFW_LINK_LIBS)
 

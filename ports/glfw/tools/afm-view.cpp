@@ -479,7 +479,9 @@ void on_key(Viewer &v, int key, int mods) {
 }
 
 void on_char(Viewer &v, unsigned codepoint) {
-  if (v.typing && codepoint >= 32 && codepoint < 127 && v.typed.size() < 40) v.typed.push_back((char)codepoint);
+  // '/' opened the entry (its character event follows the key's); no name has one.
+  if (v.typing && codepoint > 32 && codepoint < 127 && codepoint != '/' && v.typed.size() < 40)
+    v.typed.push_back((char)codepoint);
 }
 
 // A --keys entry, as if typed.

@@ -5,10 +5,10 @@
  * display needed) and libpng.
  *
  * A frame is a list of meshes (afm_render_mesh) seen through one view
- * (afm_render_view). The OpenGL drawing is afm/gl_draw.h, which the desktop
- * preview (ports/glfw) shares. Every array is caller-owned and only read during the
+ * (afm_render_view). Every array is caller-owned and only read during the
  * call. The image written is RGBA8, top row first, width * height * 4 bytes,
- * also caller-owned.
+ * also caller-owned. The OpenGL drawing itself is afm/gl_draw.h, which the
+ * desktop preview (ports/glfw) shares.
  *
  * Frame of reference: the MPEG-4 neutral frame, +x the face's own left, +y
  * up, +z forward (toward the viewer at yaw = pitch = 0). The camera looks at
