@@ -193,7 +193,8 @@ int32_t control_value(const Live &l, const Control &c) {
   return l.expression == c.number ? l.expression_value : 0;
 }
 
-// Clamps to the control's range; UsageError-free: the caller checks.
+// Sets a control, clamped to its range (a FAP's, afm_fap_value_range;
+// 0..63 for visemes and expressions).
 void set_control(Live &l, const Control &c, long value) {
   if (c.kind == AFM_TARGET_FAP) {
     int32_t lo = 0, hi = 0;
