@@ -72,13 +72,19 @@ CXX_LINK_LIBS := $(BUILDER_LIB) $(if $(RENDER_SRC),$(RENDER_LIB)) \
 # C tools link as plain C programs: the Draco codec only needs libdraco and
 # libstdc++ beside it.
 C_LINK_LIBS := $(if $(PLAYER_SRC),$(PLAYER_LIB)) $(DRACO_LIB) $(FORMAT_LIB) -ldraco -lstdc++ -lm
+# The desktop preview draws through GLFW's libGL, never libOSMesa: both define
+# the gl* functions. From libafm_render it takes the GL drawing (gl_draw.c),
+# the face scene and the PNG writer; not render.c, which would need OSMesa.
+GLFW_LIBS := $(RENDER_LIB) $(PLAYER_LIB) $(DRACO_LIB) $(FORMAT_LIB)
+GLFW_LINK_LIBS := $(GLFW_LIBS) -ldraco -lglfw -lGL -lpng -lm
 
 # ---- tools -----------------------------------------------------------------
 C_TOOLS := $(patsubst formats/tools/%.c,$(B)/bin/%,$(wildcard formats/tools/*.c)) \
   $(patsubst player_c/tools/%.c,$(B)/bin/%,$(wildcard player_c/tools/*.c))
 CXX_TOOLS := $(patsubst builder/tools/%.cpp,$(B)/bin/%,$(wildcard builder/tools/*.cpp)) \
   $(patsubst ports/osmesa/tools/%.cpp,$(B)/bin/%,$(wildcard ports/osmesa/tools/*.cpp))
-TOOLS := $(C_TOOLS) $(CXX_TOOLS)
+GLFW_TOOLS := $(patsubst ports/glfw/tools/%.cpp,$(B)/bin/%,$(wildcard ports/glfw/tools/*.cpp))
+TOOLS := $(C_TOOLS) $(CXX_TOOLS) $(GLFW_TOOLS)
 
 # ---- tests and benchmarks --------------------------------------------------
 TEST_DIRS := $(patsubst tests/%/,%,$(filter-out tests/cli/ tests/common/ tests/data/,$(sort $(dir $(wildcard tests/*/*.cpp)))))
@@ -132,6 +138,10 @@ $(B)/bin/%: $(B)/obj/ports/osmesa/tools/%.cpp.o $(LIBS)
 	@mkdir -p $(@D)
 	$(CXX) $< -o $@ $(LDFLAGS) $(CXX_LINK_LIBS)
 
+$(B)/bin/%: $(B)/obj/ports/glfw/tools/%.cpp.o $(GLFW_LIBS)
+	@mkdir -p $(@D)
+	$(CXX) $< -o $@ $(LDFLAGS) $(GLFW_LINK_LIBS)
+
 # One gtest binary per tests/<dir>/.
 .SECONDEXPANSION:
 $(B)/tests/test_%: $$(call obj,$$(wildcard tests/$$*/*.cpp)) $(call obj,$(wildcard tests/common/*.cpp)) $(LIBS)
@@ -150,7 +160,12 @@ test: deps
 	@AFM_BUILD=$(B) AFM_CONFIG=$(config) tools/run-tests.sh $(TEST_BINS)
 
 .PHONY: tests
-tests: $(TEST_BINS)
+tests: $(TEST_BINS) $(B)/tests/png_diff
+
+# The picture comparison of the command-line tests (tests/cli/png_diff.c).
+$(B)/tests/png_diff: $(B)/obj/tests/cli/png_diff.c.o $(RENDER_LIB) $(FORMAT_LIB)
+	@mkdir -p $(@D)
+	$(CC) $< -o $@ $(LDFLAGS) $(RENDER_LIB) $(FORMAT_LIB) -lpng -lm
 
 demo: deps
 	@$(MAKE) --no-print-directory all config=$(config)

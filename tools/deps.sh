@@ -6,7 +6,8 @@ set -eu
 PACKAGES="
   make g++ gcc pkg-config
   libeigen3-dev libopenmesh-dev libdraco-dev
-  libosmesa6-dev libglfw3-dev libpng-dev
+  libosmesa6-dev libglfw3-dev libgl-dev libpng-dev
+  xvfb
   libgtest-dev
   gcc-arm-linux-gnueabi libc6-dev-armel-cross qemu-user
   clang libclang-rt-14-dev

@@ -13,17 +13,6 @@ png_size() {
     awk '{ printf "%dx%d", $1 * 16777216 + $2 * 65536 + $3 * 256 + $4, $5 * 16777216 + $6 * 65536 + $7 * 256 + $8 }'
 }
 
-# A FAP mask line sending FAP 3 (open_jaw) only.
-mask() {
-  printf '0 0 1'
-  i=4
-  while [ $i -le 68 ]; do
-    printf ' 0'
-    i=$((i + 1))
-  done
-  printf '\n'
-}
-
 render="$bin/afm-render"
 "$render" --help >"$tmp/help.txt" 2>&1 || fail "--help exits non-zero"
 grep -q "usage: afm-render" "$tmp/help.txt" || fail "--help prints no usage line"
@@ -35,9 +24,9 @@ grep -q "usage: afm-render" "$tmp/help.txt" || fail "--help prints no usage line
   fail "afm-import failed"
 {
   printf '2.1 cli 25 3\n'
-  mask; printf '0 0\n'
-  mask; printf '1 600\n'
-  mask; printf '2 0\n'
+  mask_fap3; printf '0 0\n'
+  mask_fap3; printf '1 600\n'
+  mask_fap3; printf '2 0\n'
 } >"$tmp/jaw.fap"
 model="$tmp/head.afm"
 stream="$tmp/jaw.fap"
@@ -101,7 +90,7 @@ cp "$tmp/head.wrl" "$tmp/not.afm"
 expect_error "not an AFM" 1 "not\.afm: " "$o" -- "$render" "$tmp/not.afm" "$stream" -o "$o"
 {
   printf '2.1 cli 25 3\n'
-  mask; printf '0 0\n'
+  mask_fap3; printf '0 0\n'
   printf '0 0 1 0\n'
   printf '1 500\n'
 } >"$tmp/bad.fap"

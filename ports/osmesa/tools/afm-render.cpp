@@ -1,9 +1,9 @@
 // afm-render: plays a FAP stream on an AFM with the fixed-point player and
 // renders the frames offscreen (OSMesa) to PNG files and a contact sheet.
-#include <afm/draco.h>
 #include <afm/fap_stream.h>
 #include <afm/format.h>
-#include <afm/image.h>
+#include <afm/face_scene.h>
+#include <afm/view_options.h>
 #include <afm/player.h>
 #include <afm/render.h>
 
@@ -58,29 +58,9 @@ void usage(FILE *out) {
       "  --sheet-columns N     tiles per row (default: up to 6)\n"
       "  --sheet-shrink N      tiles N times smaller than the frames (default 1)\n"
       "\n"
-      "Camera and look\n"
-      "  --yaw DEG             turn the camera toward the face's left (+) or right (-)\n"
-      "  --pitch DEG           raise the camera (+) and look down\n"
-      "  --closeup             frame the face (its FDPs, without ears and hair)\n"
-      "                        instead of the whole neutral model\n"
-      "  --fov DEG             vertical field of view, 5..90 (default 25); 0 draws\n"
-      "                        an orthographic view\n"
-      "  --aa N                supersampling, 1..4 (default 2)\n"
-      "  --background R,G,B    background colour, 0..255 each (default 96,96,96)\n"
-      "  --textures DIR        look for texture files here first, then beside MODEL\n"
-      "  --no-textures         ignore textures: diffuse or vertex colours only\n"
-      "  --flip-v              turn textures upside down (v becomes 1 - v): for models\n"
-      "                        whose images are stored the other way up from what their\n"
-      "                        texture coordinates expect (VRML: v = 0 is the image's\n"
-      "                        bottom row), such as Song's TGA files\n"
-      "\n"
-      "The camera is framed once, on the neutral model's bounding box (or its face\n"
-      "with --closeup), so every frame of a run, and runs with the same options, are\n"
-      "directly comparable.\n"
-      "\n"
-      "Playing\n"
-      "  --mirror LIST         copy one-sided FAPs to the other side: lr (left/right),\n"
-      "                        io (inner/outer lip) or lr,io; off by default\n"
+      );
+  std::fputs(afm_face::kViewOptionsHelp, out);
+  std::fputs(
       "\n"
       "Other\n"
       "  --progress N          a progress line on stderr every N frames (default 25;\n"
@@ -90,68 +70,25 @@ void usage(FILE *out) {
       "\n"
       "Every PNG is written completely or not at all; when a run fails, the frames it\n"
       "wrote are removed. Exit status: 0 on success, 1 on bad input (the message names\n"
-      "the file and line, part or field) or a failed write, 2 on bad usage.\n");
+      "the file and line, part or field) or a failed write, 2 on bad usage.\n", out);
 }
 
 // Exit 2: the command line is wrong. Exit 1: an input is bad or a write failed.
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-struct InputError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-std::string lower(std::string s) {
-  for (char &c : s) c = (char)std::tolower((unsigned char)c);
-  return s;
-}
-
-long parse_long(const std::string &opt, const char *s, long lo, long hi) {
-  char *end = nullptr;
-  errno = 0;
-  const long v = std::strtol(s, &end, 10);
-  if (errno || end == s || *end || v < lo || v > hi)
-    throw UsageError(opt + ": expected a whole number from " + std::to_string(lo) + " to " +
-                     std::to_string(hi) + ", got '" + s + "'");
-  return v;
-}
-
-double parse_double(const std::string &opt, const char *s, double lo, double hi) {
-  char *end = nullptr;
-  errno = 0;
-  const double v = std::strtod(s, &end);
-  if (errno || end == s || *end || !std::isfinite(v) || v < lo || v > hi) {
-    char buf[160];
-    std::snprintf(buf, sizeof buf, ": expected a number from %g to %g, got '", lo, hi);
-    throw UsageError(opt + buf + s + "'");
-  }
-  return v;
-}
-
-std::vector<std::string> split(const std::string &s, char sep) {
-  std::vector<std::string> out;
-  size_t start = 0;
-  for (;;) {
-    const size_t p = s.find(sep, start);
-    out.push_back(s.substr(start, p == std::string::npos ? std::string::npos : p - start));
-    if (p == std::string::npos) break;
-    start = p + 1;
-  }
-  return out;
-}
+using afm_face::InputError;
+using afm_face::UsageError;
+using afm_face::lower;
+using afm_face::parse_double;
+using afm_face::parse_long;
+using afm_face::split;
 
 struct Options {
-  std::string model, stream, out_dir, sheet, textures_dir;
-  int width = 640, height = 480;
+  std::string model, stream, out_dir, sheet;
+  afm_face::ViewOptions view;  // --size, camera, look, --mirror
   long first = 0, last = -1;  // -1: to the end
   uint32_t fps_num = 0, fps_den = 1;  // 0: the stream's rate
   std::vector<long> sheet_frames;
   long sheet_every = 0, sheet_columns = 0, sheet_shrink = 1;
-  float yaw = 0, pitch = 0, fov = 25;
-  bool closeup = false, no_textures = false, quiet = false, flip_v = false;
-  int aa = 2;
-  uint8_t background[4] = {96, 96, 96, 255};
-  uint32_t mirror = 0;
+  bool quiet = false;
   long progress = 25;
 };
 
@@ -165,18 +102,14 @@ Options parse_args(int argc, char **argv, bool *help) {
       if (i + 1 >= argc) throw UsageError(a + " needs a value");
       return argv[++i];
     };
-    if (a == "--help" || a == "-h") {
+    if (afm_face::parse_view_option(a, value, o.view)) {
+      continue;
+    } else if (a == "--help" || a == "-h") {
       *help = true;
       return o;
     } else if (a == "-o" || a == "--output") {
       o.out_dir = value();
       if (o.out_dir.empty()) throw UsageError(a + ": empty directory name");
-    } else if (a == "--size") {
-      const std::string v = value();
-      const size_t x = v.find_first_of("xX");
-      if (x == std::string::npos) throw UsageError("--size: expected WxH (e.g. 640x480), got '" + v + "'");
-      o.width = (int)parse_long("--size: width (WxH)", v.substr(0, x).c_str(), 16, 4096);
-      o.height = (int)parse_long("--size: height (WxH)", v.substr(x + 1).c_str(), 16, 4096);
     } else if (a == "--frames") {
       const std::string v = value();
       const size_t c = v.find(':');
@@ -213,35 +146,6 @@ Options parse_args(int argc, char **argv, bool *help) {
       o.sheet_columns = parse_long(a, value(), 1, 100);
     } else if (a == "--sheet-shrink") {
       o.sheet_shrink = parse_long(a, value(), 1, 16);
-    } else if (a == "--yaw") {
-      o.yaw = (float)parse_double(a, value(), -360, 360);
-    } else if (a == "--pitch") {
-      o.pitch = (float)parse_double(a, value(), -89, 89);
-    } else if (a == "--fov") {
-      o.fov = (float)parse_double(a, value(), 0, 90);
-      if (o.fov > 0 && o.fov < 5) throw UsageError("--fov: 0 (orthographic) or 5..90 degrees");
-    } else if (a == "--closeup") {
-      o.closeup = true;
-    } else if (a == "--aa") {
-      o.aa = (int)parse_long(a, value(), 1, 4);
-    } else if (a == "--background") {
-      const std::string v = value();
-      const std::vector<std::string> parts = split(v, ',');
-      if (parts.size() != 3) throw UsageError("--background: expected R,G,B (0..255 each), got '" + v + "'");
-      for (int k = 0; k < 3; ++k)
-        o.background[k] = (uint8_t)parse_long("--background (R,G,B)", parts[(size_t)k].c_str(), 0, 255);
-    } else if (a == "--textures") {
-      o.textures_dir = value();
-    } else if (a == "--no-textures") {
-      o.no_textures = true;
-    } else if (a == "--flip-v") {
-      o.flip_v = true;
-    } else if (a == "--mirror") {
-      const std::string m = value();
-      if (m == "lr") o.mirror = AFM_MIRROR_LEFT_RIGHT;
-      else if (m == "io") o.mirror = AFM_MIRROR_INNER_OUTER;
-      else if (m == "lr,io" || m == "io,lr") o.mirror = AFM_MIRROR_LEFT_RIGHT | AFM_MIRROR_INNER_OUTER;
-      else throw UsageError("--mirror '" + m + "': use lr, io or lr,io");
     } else if (a == "--progress") {
       o.progress = parse_long(a, value(), 0, 100000000);
     } else if (a == "--quiet") {
@@ -264,130 +168,6 @@ Options parse_args(int argc, char **argv, bool *help) {
   if (!o.sheet_frames.empty() && o.sheet_every)
     throw UsageError("give --sheet-frames or --sheet-every, not both");
   return o;
-}
-
-// ---- inputs ------------------------------------------------------------------
-
-struct DocFree {
-  void operator()(afm_doc *d) const { afm_free(nullptr, d); }
-};
-struct MallocFree {
-  void operator()(void *p) const { std::free(p); }
-};
-
-std::vector<uint8_t> read_whole(const std::string &path) {
-  uint8_t *data = nullptr;
-  size_t size = 0;
-  errno = 0;
-  const afm_result r = afm_file_read(path.c_str(), nullptr, &data, &size);
-  if (r != AFM_OK) {
-    const int e = errno;
-    std::error_code ec;
-    if (fs::is_directory(path, ec)) throw InputError(path + ": is a directory, not a file");
-    throw InputError(path + ": cannot read: " + (e ? std::strerror(e) : afm_result_string(r)));
-  }
-  std::vector<uint8_t> out(data, data + size);
-  afm_free(nullptr, data);
-  return out;
-}
-
-std::unique_ptr<afm_doc, DocFree> load_model(const std::string &path) {
-  const std::vector<uint8_t> bytes = read_whole(path);
-  afm_diag diag{};
-  afm_read_options ro{};
-  ro.draco = afm_draco_codec();
-  ro.diag = &diag;
-  afm_doc *doc = nullptr;
-  const afm_result r = afm_doc_read_alloc(bytes.data(), bytes.size(), &ro, nullptr, &doc);
-  if (r != AFM_OK)
-    throw InputError(path + ": " + (diag.message[0] ? diag.message : afm_result_string(r)));
-  std::unique_ptr<afm_doc, DocFree> d(doc);
-  if (doc->geometry.vertex_count == 0 || doc->geometry.triangle_count == 0)
-    throw InputError(path + ": the model has no triangles to draw");
-  return d;
-}
-
-struct Stream {
-  afm_fap_header header{};
-  afm_fap_stats stats{};
-  std::vector<afm_fap_frame> frames;
-};
-
-Stream load_stream(const std::string &path) {
-  const std::vector<uint8_t> bytes = read_whole(path);
-  Stream s;
-  afm_diag diag{};
-  uint32_t count = 0;
-  afm_result r = afm_fap_parse(bytes.data(), bytes.size(), nullptr, nullptr, 0, &count, nullptr,
-                               nullptr, &diag);
-  if (r == AFM_OK) {
-    if (count == 0) throw InputError(path + ": the stream has no frames");
-    s.frames.resize(count);
-    r = afm_fap_parse(bytes.data(), bytes.size(), nullptr, s.frames.data(), count, &count, &s.header,
-                      &s.stats, &diag);
-  }
-  if (r != AFM_OK) {
-    const std::string msg = diag.message[0] ? diag.message : afm_result_string(r);
-    // The reader's messages may already start with "line N:".
-    if (diag.line && msg.rfind("line ", 0) != 0)
-      throw InputError(path + ":" + std::to_string(diag.line) + ": " + msg);
-    if (diag.line)
-      throw InputError(path + ":" + std::to_string(diag.line) + ": " + msg.substr(msg.find(':') + 2));
-    throw InputError(path + ": " + msg);
-  }
-  s.frames.resize(count);
-  return s;
-}
-
-// The file a part's texture names: in --textures DIR, then beside the model;
-// an exact name first, then the same name in another case (models made on
-// case-insensitive file systems). Empty when not found.
-std::string find_texture(const std::string &name, const std::vector<fs::path> &dirs) {
-  std::error_code ec;
-  const fs::path n(name);
-  if (n.is_absolute()) return fs::is_regular_file(n, ec) ? n.string() : std::string();
-  for (const fs::path &d : dirs) {
-    const fs::path p = d / n;
-    if (fs::is_regular_file(p, ec)) return p.string();
-  }
-  const std::string want = lower(n.filename().string());
-  for (const fs::path &d : dirs) {
-    const fs::path sub = (d / n).parent_path();
-    if (!fs::is_directory(sub, ec)) continue;
-    for (fs::directory_iterator it(sub, ec), end; !ec && it != end; it.increment(ec))
-      if (lower(it->path().filename().string()) == want && fs::is_regular_file(it->path(), ec))
-        return it->path().string();
-  }
-  return {};
-}
-
-// Cut-out textures (hair, lashes) often hold white or black where they are
-// transparent, and filtering blends that into the edges of what is drawn: a
-// bright fringe. Transparent texels take the mean colour of the opaque ones.
-void fill_transparent(afm_image *im) {
-  const size_t n = (size_t)im->width * im->height;
-  double sum[3] = {0, 0, 0}, count = 0;
-  for (size_t i = 0; i < n; ++i) {
-    const uint8_t *p = im->rgba + i * 4;
-    if (p[3] < 128) continue;
-    for (int k = 0; k < 3; ++k) sum[k] += p[k];
-    count += 1;
-  }
-  if (count == 0) return;
-  for (size_t i = 0; i < n; ++i) {
-    uint8_t *p = im->rgba + i * 4;
-    if (p[3] >= 128) continue;
-    for (int k = 0; k < 3; ++k) p[k] = (uint8_t)std::lround(sum[k] / count);
-  }
-}
-
-// ---- timeline ------------------------------------------------------------------
-
-// Microseconds from frame 0 to render frame k at num/den frames per second,
-// rounded down exactly as the cursor times the stream's own frames.
-uint64_t frame_time_us(uint64_t k, uint32_t num, uint32_t den) {
-  const uint64_t ticks = k * den;
-  return ticks / num * 1000000u + ticks % num * 1000000u / num;
 }
 
 // ---- pictures ------------------------------------------------------------------
@@ -438,22 +218,22 @@ struct Renderer {
 
 int run(const Options &o) {
   // ---- the model and the stream
-  std::unique_ptr<afm_doc, DocFree> doc = load_model(o.model);
+  const afm_face::Doc doc = afm_face::load_model(o.model);
   const afm_geometry &g = doc->geometry;
-  Stream stream = load_stream(o.stream);
+  const afm_face::Stream stream = afm_face::load_stream(o.stream);
   const uint32_t fps_num = o.fps_num ? o.fps_num : stream.header.fps_num;
   const uint32_t fps_den = o.fps_num ? o.fps_den : stream.header.fps_den;
   if (fps_num == 0 || fps_den == 0) throw InputError(o.stream + ": line 1: the frame rate is 0");
 
   afm_fap_cursor cursor;
   afm_result res = afm_fap_cursor_init(&cursor, stream.frames.data(), (uint32_t)stream.frames.size(),
-                                       stream.header.fps_num, stream.header.fps_den, o.mirror);
+                                       stream.header.fps_num, stream.header.fps_den, o.view.mirror);
   if (res != AFM_OK) throw InputError(o.stream + ": cannot play: " + afm_result_string(res));
   const uint64_t duration_us = afm_fap_cursor_duration_us(&cursor);
   // Render frames 0..total-1: every time from 0 to the last frame's.
   uint64_t total = (uint64_t)((double)duration_us * fps_num / (1e6 * fps_den));
-  while (total > 0 && frame_time_us(total, fps_num, fps_den) > duration_us) --total;
-  while (frame_time_us(total + 1, fps_num, fps_den) <= duration_us) ++total;
+  while (total > 0 && afm_face::frame_time_us(total, fps_num, fps_den) > duration_us) --total;
+  while (afm_face::frame_time_us(total + 1, fps_num, fps_den) <= duration_us) ++total;
   ++total;
   if (total > 100000000u) throw InputError(o.stream + ": more than 100000000 frames to render");
 
@@ -489,7 +269,7 @@ int run(const Options &o) {
     const long n = (long)sheet_set.size();
     const long cols = o.sheet_columns ? std::min<long>(o.sheet_columns, n) : std::min<long>(6, n);
     const long rows = (n + cols - 1) / cols;
-    const long tw = o.width / o.sheet_shrink, th = o.height / o.sheet_shrink;
+    const long tw = o.view.width / o.sheet_shrink, th = o.view.height / o.sheet_shrink;
     if (tw < 1 || th < 1) throw UsageError("--sheet-shrink: tiles would be smaller than a pixel");
     if (cols * (tw + 4) + 4 > 65535 || rows * (th + 4) + 4 > 65535)
       throw UsageError("--sheet: " + std::to_string(n) + " tiles of " + std::to_string(tw) + "x" +
@@ -502,49 +282,9 @@ int run(const Options &o) {
   else
     to_render.assign(sheet_set.begin(), sheet_set.end());
 
-  // ---- textures
-  std::vector<fs::path> tex_dirs;
-  if (!o.textures_dir.empty()) {
-    std::error_code ec;
-    if (!fs::is_directory(o.textures_dir, ec))
-      throw InputError("--textures " + o.textures_dir + ": not a directory");
-    tex_dirs.push_back(o.textures_dir);
-  }
-  {
-    fs::path beside = fs::path(o.model).parent_path();
-    tex_dirs.push_back(beside.empty() ? fs::path(".") : beside);
-  }
-  struct Texture {
-    afm_image image{};
-    afm_render_image view{};
-    ~Texture() { afm_image_free(&image); }
-  };
-  std::map<std::string, std::unique_ptr<Texture>> textures;  // by file path
-  std::vector<const Texture *> part_texture(g.part_count, nullptr);
-  const bool have_uvs = g.u && g.v && (g.attributes & AFM_ATTR_TEXCOORDS);
-  if (have_uvs && !o.no_textures) {
-    for (uint32_t p = 0; p < g.part_count; ++p) {
-      const afm_part &part = g.parts[p];
-      if (!part.texture || !part.texture[0] || part.triangle_count == 0) continue;
-      const std::string file = find_texture(part.texture, tex_dirs);
-      if (file.empty()) {
-        std::string where;
-        for (const fs::path &d : tex_dirs) where += (where.empty() ? "" : " or ") + d.string();
-        throw InputError(o.model + ": part " + part.name + ": texture '" + part.texture +
-                         "' is not in " + where + " (give --textures DIR, or --no-textures)");
-      }
-      auto it = textures.find(file);
-      if (it == textures.end()) {
-        auto t = std::make_unique<Texture>();
-        if (afm_image_read(file.c_str(), &t->image) != AFM_OK)
-          throw InputError(std::string(afm_render_last_error()) + " (texture of part " + part.name + ")");
-        if (t->image.has_alpha) fill_transparent(&t->image);
-        t->view = {t->image.rgba, t->image.width, t->image.height};
-        it = textures.emplace(file, std::move(t)).first;
-      }
-      part_texture[p] = it->second.get();
-    }
-  }
+  // ---- the model's meshes, textures, player and framing
+  afm_face::FaceScene face;
+  afm_face::init_face(face, *doc, afm_face::face_options(o.view, o.model));
 
   // ---- output places, checked before any work
   Written written;
@@ -565,92 +305,8 @@ int run(const Options &o) {
       throw InputError(o.sheet + ": the directory " + parent.string() + " does not exist");
   }
 
-  // ---- the player
-  afm_player_options po{};
-  size_t player_bytes = 0;
-  res = afm_player_measure(doc.get(), &po, &player_bytes);
-  std::unique_ptr<void, MallocFree> player_memory;
-  if (res == AFM_OK) {
-    player_memory.reset(std::malloc(player_bytes ? player_bytes : 1));
-    if (!player_memory) res = AFM_ERR_OUT_OF_MEMORY;
-  }
-  afm_player *player = nullptr;
-  if (res == AFM_OK) res = afm_player_init(doc.get(), &po, player_memory.get(), player_bytes, &player);
-  if (res != AFM_OK) throw InputError(o.model + ": cannot play: " + afm_result_string(res));
-
-  // ---- meshes: one per part over shared vertex arrays (triangles index the
-  // whole vertex list)
-  const size_t V = g.vertex_count;
-  std::vector<float> pos(V * 3), nrm(V * 3), uvs;
-  if (have_uvs) {
-    uvs.resize(V * 2);
-    for (size_t v = 0; v < V; ++v) {
-      uvs[v * 2] = (float)(g.uv_origin[0] + (double)g.u[v] * g.uv_step[0]);
-      const double tv = g.uv_origin[1] + (double)g.v[v] * g.uv_step[1];
-      uvs[v * 2 + 1] = (float)(o.flip_v ? 1.0 - tv : tv);
-    }
-  }
-  std::vector<afm_render_mesh> meshes;
-  size_t textured_parts = 0;
-  for (uint32_t p = 0; p < g.part_count; ++p) {
-    const afm_part &part = g.parts[p];
-    if (part.triangle_count == 0) continue;
-    afm_render_mesh m{};
-    m.positions = pos.data();
-    m.vertex_count = V;
-    m.triangles = g.triangles + (size_t)part.first_triangle * 3;
-    m.triangle_count = part.triangle_count;
-    m.normals = nrm.data();
-    const bool colours = g.rgba && (g.attributes & AFM_ATTR_COLORS);
-    m.colors = colours ? g.rgba : nullptr;
-    if (part_texture[p]) {
-      // VRML: a texture replaces the diffuse colour (vertex colours still modulate).
-      m.uvs = uvs.data();
-      m.texture = &part_texture[p]->view;
-      m.texture_static = 1;  // loaded once, never changed
-      for (int k = 0; k < 4; ++k) m.color[k] = 1.0f;
-      if (part_texture[p]->image.has_alpha) m.alpha_cutoff = 0.5f;
-      ++textured_parts;
-    } else {
-      for (int k = 0; k < 4; ++k) m.color[k] = part.diffuse[k] / 255.0f;
-      m.color[3] = 1.0f;
-    }
-    meshes.push_back(m);
-  }
-
   // ---- the camera: framed once on the neutral model (or its face)
-  afm_render_view view;
-  afm_render_view_init(&view, o.width, o.height);
-  view.yaw_deg = o.yaw;
-  view.pitch_deg = o.pitch;
-  view.fov_deg = o.fov;
-  view.supersample = o.aa;
-  std::memcpy(view.background, o.background, 4);
-  {
-    float lo[3] = {1e30f, 1e30f, 1e30f}, hi[3] = {-1e30f, -1e30f, -1e30f};
-    if (o.closeup) {
-      for (uint32_t i = 0; i < doc->meta.fdp_count; ++i) {
-        const afm_fdp_point &f = doc->meta.fdps[i];
-        if (f.group == 7 || f.group == 10 || f.group == 11) continue;  // spine, ears, skull
-        for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], f.pos[k]), hi[k] = std::max(hi[k], f.pos[k]);
-      }
-      if (lo[0] > hi[0] || hi[1] - lo[1] <= 0)
-        throw InputError(o.model + ": --closeup frames the face by its FDPs, and the model has none");
-      // Room around the features, more above them for the forehead.
-      const float pad = 0.15f * (hi[1] - lo[1]);
-      for (int k = 0; k < 3; ++k) lo[k] -= pad, hi[k] += pad;
-      hi[1] += 2 * pad;
-    } else {
-      const int16_t *q[3] = {g.px, g.py, g.pz};
-      for (size_t v = 0; v < V; ++v)
-        for (int k = 0; k < 3; ++k) {
-          const float x = (float)(g.origin[k] + (double)q[k][v] * g.step);
-          lo[k] = std::min(lo[k], x);
-          hi[k] = std::max(hi[k], x);
-        }
-    }
-    for (int k = 0; k < 3; ++k) view.box_min[k] = lo[k], view.box_max[k] = hi[k];
-  }
+  const afm_render_view view = afm_face::make_view(o.view, face, o.view.width, o.view.height);
 
   if (!o.quiet) {
     std::printf("%s: %zu frames at %lu/%lu fps (%.3f s); rendering %zu frame(s) at %s (%s, frames %ld to %ld)\n",
@@ -658,15 +314,15 @@ int run(const Options &o) {
                 (unsigned long)stream.header.fps_den, (double)duration_us * 1e-6, to_render.size(),
                 rate, o.fps_num ? "resampled" : "the stream's rate", first, last);
     std::printf("%s: %lu vertices, %lu triangles, %lu parts (%zu textured, %zu texture files%s)\n",
-                o.model.c_str(), (unsigned long)V, (unsigned long)g.triangle_count,
-                (unsigned long)g.part_count, textured_parts, textures.size(),
+                o.model.c_str(), (unsigned long)g.vertex_count, (unsigned long)g.triangle_count,
+                (unsigned long)g.part_count, face.textured_parts, face.textures.size(),
                 g.rgba ? ", vertex colours" : "");
     std::fflush(stdout);
   }
 
   // ---- render
   Renderer renderer;
-  std::vector<uint8_t> rgba((size_t)o.width * o.height * 4);
+  std::vector<uint8_t> rgba((size_t)o.view.width * o.view.height * 4);
   std::vector<std::vector<uint8_t>> sheet_tiles;
   double t_pose = 0, t_draw = 0, t_png = 0;
   const auto t_start = std::chrono::steady_clock::now();
@@ -675,20 +331,13 @@ int run(const Options &o) {
     auto t0 = std::chrono::steady_clock::now();
     const afm_fap_state *a = nullptr, *b = nullptr;
     afm_q16 t = 0;
-    res = afm_fap_cursor_seek(&cursor, frame_time_us((uint64_t)f, fps_num, fps_den), &a, &b, &t);
-    if (res == AFM_OK) res = afm_player_pose(player, a, b, t);
+    res = afm_fap_cursor_seek(&cursor, afm_face::frame_time_us((uint64_t)f, fps_num, fps_den), &a, &b, &t);
+    if (res == AFM_OK) res = afm_face::pose_face(face, a, b, t);
     if (res != AFM_OK)
       throw InputError("frame " + std::to_string(f) + ": the player fails: " + afm_result_string(res));
-    const int32_t *x = afm_player_positions(player);
-    const afm_q14 *n = afm_player_normals(player);
-    for (size_t i = 0; i < V; ++i)
-      for (int k = 0; k < 3; ++k) {
-        pos[i * 3 + (size_t)k] = (float)(g.origin[k] + (double)x[i * 3 + (size_t)k] * g.step);
-        nrm[i * 3 + (size_t)k] = (float)n[i * 3 + (size_t)k] * (1.0f / 16384.0f);
-      }
     t_pose += ms_since(t0);
     t0 = std::chrono::steady_clock::now();
-    if (afm_renderer_draw(renderer.r, meshes.data(), meshes.size(), &view, rgba.data()) != AFM_OK)
+    if (afm_renderer_draw(renderer.r, face.meshes.data(), face.meshes.size(), &view, rgba.data()) != AFM_OK)
       throw InputError("frame " + std::to_string(f) + ": " + afm_render_last_error());
     t_draw += ms_since(t0);
     t0 = std::chrono::steady_clock::now();
@@ -696,7 +345,7 @@ int run(const Options &o) {
       char name[32];
       std::snprintf(name, sizeof name, "frame_%05ld.png", f);
       const std::string path = (fs::path(o.out_dir) / name).string();
-      const afm_render_image im = {rgba.data(), o.width, o.height};
+      const afm_render_image im = {rgba.data(), o.view.width, o.view.height};
       if (afm_png_write(path.c_str(), &im) != AFM_OK) throw InputError(afm_render_last_error());
       written.files.push_back(path);
     }
@@ -716,10 +365,10 @@ int run(const Options &o) {
   if (!o.sheet.empty()) {
     std::vector<std::vector<uint8_t>> small;
     std::vector<afm_render_image> tiles;
-    int tw = o.width, th = o.height;
+    int tw = o.view.width, th = o.view.height;
     for (const std::vector<uint8_t> &tile : sheet_tiles) {
       if (o.sheet_shrink > 1) {
-        small.push_back(shrink(tile, o.width, o.height, (int)o.sheet_shrink, &tw, &th));
+        small.push_back(shrink(tile, o.view.width, o.view.height, (int)o.sheet_shrink, &tw, &th));
         tiles.push_back({small.back().data(), tw, th});
       } else {
         tiles.push_back({tile.data(), tw, th});
@@ -736,13 +385,13 @@ int run(const Options &o) {
   if (!o.quiet) {
     const double n = (double)std::max<size_t>(done, 1);
     if (!o.out_dir.empty())
-      std::printf("wrote %zu frame(s) of %dx%d to %s (frame_%05ld.png to frame_%05ld.png)\n", done, o.width,
-                  o.height, o.out_dir.c_str(), first, last);
+      std::printf("wrote %zu frame(s) of %dx%d to %s (frame_%05ld.png to frame_%05ld.png)\n", done, o.view.width,
+                  o.view.height, o.out_dir.c_str(), first, last);
     if (!o.sheet.empty())
       std::printf("wrote %s: %zu frame(s), %d per row, %dx%d\n", o.sheet.c_str(), sheet_tiles.size(), columns,
                   sheet_w, sheet_h);
     std::printf("time per frame: pose %.2f ms, render %.1f ms, PNG %.1f ms (%dx%d, %dx supersampled)\n",
-                t_pose / n, t_draw / n, t_png / n, o.width, o.height, o.aa);
+                t_pose / n, t_draw / n, t_png / n, o.view.width, o.view.height, o.view.aa);
     if (stream.stats.clamped)
       std::printf("note: %s: %lu value(s) outside their FAP's range were clamped\n", o.stream.c_str(),
                   (unsigned long)stream.stats.clamped);
@@ -753,7 +402,7 @@ int run(const Options &o) {
 }  // namespace
 
 int main(int argc, char **argv) {
-  try {
+  return afm_face::run_tool("afm-render", [&] {
     bool help = false;
     const Options o = parse_args(argc, argv, &help);
     if (help) {
@@ -761,14 +410,5 @@ int main(int argc, char **argv) {
       return 0;
     }
     return run(o);
-  } catch (const UsageError &e) {
-    std::fprintf(stderr, "afm-render: %s\n(afm-render --help lists the options)\n", e.what());
-    return 2;
-  } catch (const InputError &e) {
-    std::fprintf(stderr, "afm-render: %s\n", e.what());
-    return 1;
-  } catch (const std::bad_alloc &) {
-    std::fprintf(stderr, "afm-render: out of memory\n");
-    return 1;
-  }
+  });
 }

@@ -7,6 +7,7 @@
 #                     (grep -E), OUTPUT ('-' for none) does not exist, and no
 #                     temporary file is left in $tmp
 #   finish [NOTE]     prints the verdict and exits 0 or 1
+#   mask_fap3         prints a FAP stream's mask line sending FAP 3 (open_jaw) only
 set -u
 : "${AFM_BUILD:=build}"
 bin="$AFM_BUILD/bin"
@@ -38,6 +39,16 @@ expect_error() {
   if find "$tmp" -name '*.tmp*' | grep -q .; then
     fail "$name: left a temporary file: $(find "$tmp" -name '*.tmp*')"
   fi
+}
+
+mask_fap3() {
+  printf '0 0 1'
+  i=4
+  while [ $i -le 68 ]; do
+    printf ' 0'
+    i=$((i + 1))
+  done
+  printf '\n'
 }
 
 finish() {

@@ -7,7 +7,8 @@
  * A frame is a list of meshes (afm_render_mesh) seen through one view
  * (afm_render_view). Every array is caller-owned and only read during the
  * call. The image written is RGBA8, top row first, width * height * 4 bytes,
- * also caller-owned.
+ * also caller-owned. The OpenGL drawing itself is afm/gl_draw.h, which the
+ * desktop preview (ports/glfw) shares.
  *
  * Frame of reference: the MPEG-4 neutral frame, +x the face's own left, +y
  * up, +z forward (toward the viewer at yaw = pitch = 0). The camera looks at
@@ -89,6 +90,9 @@ typedef struct afm_render_view {
   uint8_t background[4];      /* RGBA */
   int supersample;            /* 1..4: render s times larger and average (anti-aliasing) */
   float wire_color[4];        /* wireframe RGBA; all zero means dark grey */
+  float zoom;                 /* > 1 moves the camera closer (its distance, or an
+                                 orthographic view's extent, divided by zoom),
+                                 < 1 away; 0 means 1: the box just fits */
 } afm_render_view;
 
 /* Width x height, front view, 25 degree lens, box from the meshes, 6 %
