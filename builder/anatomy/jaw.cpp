@@ -78,6 +78,10 @@ Expected<Jaw> build_jaw(const SkinModel &skin, const FdpSet &fdps, const Fapu &f
   return jaw;
 }
 
+Eigen::MatrixXd moved_points(const Eigen::Affine3d &motion, const Eigen::MatrixXd &V) {
+  return (V * motion.linear().transpose()).rowwise() + motion.translation().transpose();
+}
+
 Eigen::Affine3d jaw_motion(const Jaw &jaw, double open_pct, double thrust_pct, double shift_pct) {
   const double angle = std::max(0.0, open_pct) / 100.0 * jaw.max_open;
   Eigen::Affine3d t = Eigen::Affine3d::Identity();

@@ -61,4 +61,7 @@ Expected<Jaw> build_jaw(const SkinModel &skin, const FdpSet &fdps, const Fapu &f
 // The rigid motion for opening, thrust and shift in percent (open >= 0).
 Eigen::Affine3d jaw_motion(const Jaw &jaw, double open_pct, double thrust_pct, double shift_pct);
 
+// The points V (#V x 3, model units) moved by `motion`: #V x 3.
+Eigen::MatrixXd moved_points(const Eigen::Affine3d &motion, const Eigen::MatrixXd &V);
+
 }  // namespace afmb

@@ -164,8 +164,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         if (!jaw.matrix().isIdentity(0))
           for (int p : out.jaw.parts) {
             const Eigen::MatrixXd &V = scene.parts[static_cast<size_t>(p)].V;
-            t.displacement[static_cast<size_t>(p)] =
-                (V * jaw.linear().transpose()).rowwise() + jaw.translation().transpose() - V;
+            t.displacement[static_cast<size_t>(p)] = moved_points(jaw, V) - V;
           }
         res.target = std::move(t);
       }

@@ -11,7 +11,7 @@
 #include <system_error>
 
 #include "core/atomic_file.h"
-#include "core/fapu.h"
+#include "anatomy/jaw.h"
 #include "render/scene_render.h"
 
 namespace afmb {
@@ -34,6 +34,13 @@ std::string format(const char *fmt, ...) {
   std::vsnprintf(buf, sizeof buf, fmt, ap);
   va_end(ap);
   return buf;
+}
+
+// The table's first column: "12", "v10", "e1".
+std::string target_id(const FapOutcome &o) {
+  if (o.kind == AFM_TARGET_VISEME) return format("v%d", o.number);
+  if (o.kind == AFM_TARGET_EXPRESSION) return format("e%d", o.number);
+  return format("%d", o.number);
 }
 
 // "fap03", "fap03-neg", "viseme01", "expression1".
@@ -104,9 +111,7 @@ std::string fidelity_table(const FapSynthesis &s) {
   std::vector<double> along, off, reach;
   int failed = 0;
   for (const FapOutcome &o : s.outcomes) {
-    const std::string id = o.kind == AFM_TARGET_VISEME       ? format("v%d", o.number)
-                           : o.kind == AFM_TARGET_EXPRESSION ? format("e%d", o.number)
-                                                             : format("%d", o.number);
+    const std::string id = target_id(o);
     const std::string name = target_label(o);
     if (!o.made) {
       ++failed;
@@ -197,7 +202,7 @@ Status write_fidelity_report(const std::string &dir, const Scene &scene, const F
     if (!jaw.matrix().isIdentity(0))
       for (int p : s.jaw.parts) {
         Eigen::MatrixXd &V = posed.parts[static_cast<size_t>(p)].V;
-        V = ((V * jaw.linear().transpose()).rowwise() + jaw.translation().transpose()).eval();
+        V = moved_points(jaw, V);
       }
     // Red where the skin moves, in proportion to the target's largest motion.
     const Eigen::MatrixXd &D = t.displacement[skin];
@@ -249,9 +254,7 @@ Status write_fidelity_report(const std::string &dir, const Scene &scene, const F
           "<th class=\"l\">note</th></tr>\n";
   html += "<tr><td><img src=\"targets/neutral.png\"></td><td></td><td class=\"l\">neutral</td><td colspan=7></td></tr>\n";
   for (const FapOutcome &o : s.outcomes) {
-    const std::string num = o.kind == AFM_TARGET_VISEME       ? format("v%d", o.number)
-                            : o.kind == AFM_TARGET_EXPRESSION ? format("e%d", o.number)
-                                                              : format("%d", o.number);
+    const std::string num = target_id(o);
     html += "<tr><td>";
     if (o.made) html += "<img src=\"targets/" + file_stem(o) + ".png\">";
     html += "</td><td>" + num + "</td><td class=\"l\">" + html_escape(target_label(o)) + "</td>";

@@ -409,9 +409,7 @@ Status render_pose_png(const Scene &scene, const FaceModel &model, const Pose &p
   Scene s = scene;
   s.parts[model.skin].V = pose_epidermis(model, pose);
   for (Part &p : s.parts) {
-    if (p.kind != PartKind::TeethLower && p.kind != PartKind::Tongue) continue;
-    for (int i = 0; i < p.V.rows(); ++i)
-      p.V.row(i) = (jaw * Eigen::Vector3d(p.V.row(i).transpose())).transpose();
+    if (p.kind == PartKind::TeethLower || p.kind == PartKind::Tongue) p.V = moved_points(jaw, p.V);
   }
   return draw(s, model, {}, path, options);
 }
