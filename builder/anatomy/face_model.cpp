@@ -345,7 +345,7 @@ Status muscle_set(const FaceModel &model, const std::vector<std::pair<int, doubl
 
 Expected<Pose> solve_pose_to(const FaceModel &model, const std::vector<std::pair<int, double>> &pattern,
                              const PoseAction &action, double value, FactorCache *cache, double *scale,
-                             double max_scale, bool *capped) {
+                             double max_scale, bool *capped, const SteerFrom *from) {
   Pose pose;
   pose.X = model.tissue.X0;
   std::vector<int> set;
@@ -356,8 +356,18 @@ Expected<Pose> solve_pose_to(const FaceModel &model, const std::vector<std::pair
   control.action = action;
   control.value = value;
   control.max_tension = max_scale;
+  SolverOptions opts = model.solver;
+  if (from && from->pose) {
+    pose.X = from->pose->X;
+    std::vector<int> u;
+    std::set_union(set.begin(), set.end(), from->pose->dynamic.begin(), from->pose->dynamic.end(),
+                   std::back_inserter(u));
+    set = std::move(u);
+    control.tension = from->scale;
+  }
+  if (from && from->max_iterations > 0) opts.max_iterations = from->max_iterations;
   FactorCache local;
-  Status s = solve_growing(model, set, nullptr, model.tissue.X0, pose.X, model.solver, model.wave_threshold,
+  Status s = solve_growing(model, set, nullptr, model.tissue.X0, pose.X, opts, model.wave_threshold,
                            cache ? cache : &local, false, &pose.stats, &pose.rounds, &control);
   if (!s) return s.wrap("pose");
   if (scale) *scale = control.tension;
@@ -401,6 +411,30 @@ Expected<Pose> solve_pose(const FaceModel &model, const Activation &a, FactorCac
 
 Eigen::MatrixXd pose_epidermis(const FaceModel &model, const Pose &pose) {
   return pose.X.topRows(model.tissue.n);
+}
+
+SkinFaults skin_faults(const FaceModel &model, const Eigen::MatrixXd &E) {
+  const SkinModel &s = model.tissue;
+  SkinFaults out;
+  auto normal = [&s](const Eigen::MatrixXd &X, Eigen::Index f) {
+    const Eigen::Vector3d a = X.row(s.F(f, 0)), b = X.row(s.F(f, 1)), c = X.row(s.F(f, 2));
+    return Eigen::Vector3d((b - a).cross(c - a));
+  };
+  double mean = 0;
+  for (Eigen::Index f = 0; f < s.F.rows(); ++f) mean += normal(s.X0, f).norm();
+  mean /= std::max<double>(1, static_cast<double>(s.F.rows()));
+  for (Eigen::Index f = 0; f < s.F.rows(); ++f) {
+    const Eigen::Vector3d n0 = normal(s.X0, f);
+    if (n0.norm() > 1e-3 * mean && n0.dot(normal(E, f)) <= 0) ++out.flipped;
+  }
+  std::vector<char> on_jaw(static_cast<size_t>(s.n), 0);
+  for (int v : model.jaw.vertices) on_jaw[static_cast<size_t>(v)] = 1;
+  for (int v = 0; v < s.n; ++v) {
+    if (on_jaw[static_cast<size_t>(v)] || !s.in_mesh[static_cast<size_t>(v)] || !skull_rejects(s, v)) continue;
+    const Eigen::Vector3d skull = s.X0.row(s.node(kSkull, v));
+    if ((E.row(v).transpose() - skull).dot(s.normal.row(v).transpose()) < 0) ++out.sunk;
+  }
+  return out;
 }
 
 }  // namespace afmb

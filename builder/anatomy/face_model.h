@@ -124,12 +124,34 @@ using PoseAction = std::function<double(const Eigen::MatrixXd &X, Eigen::MatrixX
 // `value`, and *capped (when given) is set. Fails as solve_pose does, and when
 // the group cannot take the action to `value` (the message says how far it
 // got).
+//
+// With `from`, the solve starts from from->pose (found before for the same
+// pattern and action, at scale from->scale) instead of the rest state, on
+// its set, and may take from->max_iterations Newton iterations (0: the
+// model's solver's) before it fails.
+struct SteerFrom {
+  const Pose *pose = nullptr;
+  double scale = 0;
+  int max_iterations = 0;
+};
 Expected<Pose> solve_pose_to(const FaceModel &model, const std::vector<std::pair<int, double>> &pattern,
                              const PoseAction &action, double value, FactorCache *cache, double *scale,
-                             double max_scale = 0, bool *capped = nullptr);
+                             double max_scale = 0, bool *capped = nullptr, const SteerFrom *from = nullptr);
 
 // The epidermis of a pose, #V x 3 (the skin part's vertex positions).
 Eigen::MatrixXd pose_epidermis(const FaceModel &model, const Pose &pose);
+
+// What is wrong with an epidermis E (#V x 3, model units) as a face: skin
+// triangles whose normal turned against its rest one (slivers under a
+// thousandth of the mean area left out), and vertices tied to the skull
+// that went below their skull node's rest plane (the jaw's vertices left
+// out: the jaw moves their bone).
+struct SkinFaults {
+  int flipped = 0;
+  int sunk = 0;
+  bool any() const { return flipped > 0 || sunk > 0; }
+};
+SkinFaults skin_faults(const FaceModel &model, const Eigen::MatrixXd &E);
 
 // The signed tension of muscle i at `percent` contraction.
 double muscle_tension(const Muscle &m, double percent);

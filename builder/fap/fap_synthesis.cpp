@@ -19,6 +19,10 @@ namespace afmb {
 
 namespace {
 
+// Newton iterations allowed to a solve beyond the calibrated range: where
+// the tissue locks it would take hundreds (Song's lower eyelids).
+constexpr int kBeyondIterations = 40;
+
 bool is_jaw(FapDriver d) { return d == FapDriver::JawOpen || d == FapDriver::JawThrust || d == FapDriver::JawShift; }
 
 // The jaw percentage that moves point p by `value` along `dir` (model units),
@@ -269,18 +273,46 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         FactorCache cache;
         double scale = 0;
         bool capped = false;
-        // Within the calibrated range: the scale stops at 1 (the table's
-        // contractions), and the pose is then the group at 1.
-        Expected<Pose> pz = solve_pose_to(model, pattern, action, value, &cache, &scale, 1.0, &capped);
+        // Within the calibrated range first (s <= 1). A group that falls
+        // short there may pass it, its tensions extrapolated up to
+        // kMaxFapScale, in one more solve from the pose at s = 1 with a
+        // budget of Newton iterations; that pose is kept only if the skin
+        // stays a face.
+        double cap = 1;
+        Expected<Pose> pz = solve_pose_to(model, pattern, action, value, &cache, &scale, cap, &capped);
+        std::string beyond_why;  // why the group stayed within its range
+        if (pz && capped) {
+          SteerFrom from;
+          from.pose = &*pz;
+          from.scale = scale;
+          from.max_iterations = kBeyondIterations;
+          double s2 = 0;
+          bool capped2 = false;
+          Expected<Pose> beyond = solve_pose_to(model, pattern, action, value, &cache, &s2, kMaxFapScale,
+                                                &capped2, &from);
+          if (!beyond) {
+            beyond_why = "beyond it the solve fails";
+          } else if (skin_faults(model, pose_epidermis(model, *beyond)).any()) {
+            beyond_why = "beyond it the skin folds or sinks into the skull";
+          } else {
+            pz = std::move(beyond);
+            scale = s2, capped = capped2, cap = kMaxFapScale;
+          }
+        }
         if (pz && !capped) {
           pose = std::move(*pz);
           o.scale = scale;
           ok = true;
         } else {
-          // The reference is what the group reaches at its table
-          // contractions. Where the load control failed (the FDP moves the
-          // wrong way), a plain pose says how far and which way.
-          const std::string why = pz ? "the table's contractions reach less" : pz.status().message();
+          // The target is then the most the group does at the cap. Where
+          // the load control failed (the FDP moves the wrong way), a plain
+          // pose says how far and which way.
+          const std::string why = !pz                 ? pz.status().message()
+                                  : !beyond_why.empty() ? "the table's contractions reach less, and " + beyond_why
+                                                        : "the group reaches less at " +
+                                                              std::to_string(static_cast<int>(kMaxFapScale)) +
+                                                              " times the table's contractions";
+          const bool at_cap = static_cast<bool>(pz);
           Expected<Pose> full = std::move(pz);
           if (!full) {
             Activation a;
@@ -301,7 +333,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
               // group does, so streams at the reference see the muscles at
               // their range instead of a small target extrapolated many times.
               pose = std::move(*full);
-              o.scale = 1;
+              o.scale = at_cap ? cap : 1;
               if (reach >= value) {
                 // The load control stopped at the cap just short of the value,
                 // and the equilibrium there lies beyond it: scale the few

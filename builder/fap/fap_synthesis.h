@@ -15,14 +15,20 @@
 // the jaw opens, the jaw's rigid parts carried by it (these targets have no
 // rigid control).
 //
-// The scale stays within the muscles' calibrated range (s <= 1 with the
-// table's contractions at 100 %). A group that cannot reach the reference
-// there makes its target at s = 1 and keeps the table's reference: the
-// target under-reaches (the outcome says by how much), and a stream at the
-// reference shows the muscles at their range. (Lowering the reference to
+// The scale is first found within the muscles' calibrated range (s <= 1,
+// s = 1: the table's contractions at 100 %). A group that falls short there
+// gets one more solve, from that pose, that may pass the range with its
+// tensions extrapolated up to kMaxFapScale, within a budget of Newton
+// iterations; its pose is kept if the skin stays a face (face_model.h,
+// skin_faults: no skin triangle turned over, nothing below the skull),
+// else the pose at s = 1 is. A group that cannot reach the reference makes
+// its target at that cap and keeps the table's reference: the target
+// under-reaches (the outcome says by how much and why), and a stream at the
+// reference shows the muscles at their most. (Lowering the reference to
 // what the group reaches kept the MPEG-4 rule exact, but real streams then
-// extrapolated small targets up to 90 times and tore the face.) A group that
-// moves its FDP the wrong way, or by less than a FAP unit, gets no target.
+// extrapolated small targets up to 90 times and tore the face.) A group
+// that moves its FDP the wrong way, or by less than a FAP unit, gets no
+// target.
 //
 // What is measured per target (the fidelity report): the prescribed FDP
 // displacement, the achieved one, the error along the FAP's direction and
@@ -41,6 +47,9 @@
 #include "core/status.h"
 
 namespace afmb {
+
+// The most a FAP's muscle group is scaled beyond its table contractions.
+constexpr double kMaxFapScale = 4;
 
 struct FapOutcome {
   afm_target_kind kind = AFM_TARGET_FAP;

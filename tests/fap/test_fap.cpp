@@ -328,6 +328,53 @@ TEST(FapSynthesis, NoTargetFlipsASkinTriangleOrSinksIntoTheSkull) {
   }
 }
 
+// The check that stops a group's extrapolation (face_model.h) sees a fold
+// and a vertex pushed into the skull, and nothing at rest.
+TEST(FapSynthesis, SkinFaultsSeeAFoldAndASunkVertex) {
+  const FaceModel &m = head_1k().model;
+  const SkinModel &s = m.tissue;
+  const Eigen::MatrixXd R = s.X0.topRows(s.n);
+  EXPECT_FALSE(skin_faults(m, R).any());
+  // A skull-tied vertex off the jaw, on the forehead: pushed through its
+  // skull node to the other side of the rest plane.
+  int v = -1;
+  for (int i = 0; i < s.n && v < 0; ++i)
+    if (s.in_mesh[static_cast<size_t>(i)] && skull_rejects(s, i) && s.X0(i, 1) > s.centre.y() + 0.05) v = i;
+  ASSERT_GE(v, 0);
+  std::vector<char> jaw(static_cast<size_t>(s.n), 0);
+  for (int j : m.jaw.vertices) jaw[static_cast<size_t>(j)] = 1;
+  ASSERT_FALSE(jaw[static_cast<size_t>(v)]);
+  Eigen::MatrixXd E = R;
+  const Eigen::Vector3d skull = s.X0.row(s.node(kSkull, v));
+  E.row(v) = (skull - 0.002 * Eigen::Vector3d(s.normal.row(v))).transpose();
+  EXPECT_GE(skin_faults(m, E).sunk, 1);
+  // A fold alone: one triangle's corner carried across its opposite edge,
+  // within the surface.
+  E = R;
+  const Eigen::Vector3d a = R.row(s.F(0, 0)), b = R.row(s.F(0, 1)), c = R.row(s.F(0, 2));
+  E.row(s.F(0, 0)) = (b + c - a).transpose();
+  EXPECT_GE(skin_faults(m, E).flipped, 1);
+}
+
+// Groups too weak within their calibrated range pass it (their tensions
+// extrapolated) up to kMaxFapScale: frontalis lowering the brow (FAP 33's
+// negative side) does, and its target still meets the MPEG-4 rule
+// (EachTargetMovesItsFdp...) without folding the skin (NoTargetFlips...).
+TEST(FapSynthesis, AWeakGroupPassesItsRangeUpToTheCap) {
+  bool beyond = false;
+  for (const FapOutcome &o : synthesis().outcomes) {
+    if (o.kind != AFM_TARGET_FAP || !o.made) continue;
+    SCOPED_TRACE("FAP " + std::to_string(o.number) + " side " + std::to_string(o.side));
+    EXPECT_GT(o.scale, 0);
+    EXPECT_LE(o.scale, kMaxFapScale);
+    beyond |= o.scale > 1;
+    if (o.reached < 1) {
+      EXPECT_NE(o.message.find("reaches"), std::string::npos) << o.message;
+    }
+  }
+  EXPECT_TRUE(beyond);
+}
+
 TEST(FapSynthesis, AMissingMuscleIsAReportNotAnError) {
   const Built &b = head_1k();
   // FAP 37 needs corrugator_left, which this model did not calibrate: the
@@ -371,6 +418,40 @@ TEST(FapSynthesis, ASteeredPoseStopsAtTheCalibratedRange) {
   EXPECT_FALSE(capped);
   EXPECT_LT(scale, 1.0);
   EXPECT_NEAR(muscle_action(m.tissue, mu, p->X), 0.5 * muscle_action_target(mu, true), 4 * m.solver.tolerance);
+}
+
+// Passing the range from the pose at s = 1 (SteerFrom, as the synthesis
+// does) finds the pose a solve from rest finds: the equilibrium at a scale
+// does not depend on where Newton started.
+TEST(FapSynthesis, ASteeredPoseFromTheRangesEndMeetsTheOneFromRest) {
+  const FaceModel &m = head_1k().model;
+  const int i = m.find("zygomaticus_major_left");
+  const Muscle &mu = m.muscles[static_cast<size_t>(i)];
+  const std::vector<std::pair<int, double>> pattern = {{i, 100.0}};
+  PoseAction action = [&](const Eigen::MatrixXd &X, Eigen::MatrixXd *g) { return muscle_action(m.tissue, mu, X, g); };
+  FactorCache cache;
+  const double value = 1.5 * muscle_action_target(mu, true);
+  double s1 = 0, s2 = 0, s3 = 0;
+  bool capped = false;
+  Expected<Pose> at_one = solve_pose_to(m, pattern, action, value, &cache, &s1, 1.0, &capped);
+  ASSERT_TRUE(at_one.is_ok()) << at_one.status().message();
+  ASSERT_TRUE(capped);
+  SteerFrom from;
+  from.pose = &*at_one;
+  from.scale = s1;
+  from.max_iterations = 40;
+  Expected<Pose> beyond = solve_pose_to(m, pattern, action, value, &cache, &s2, kMaxFapScale, &capped, &from);
+  ASSERT_TRUE(beyond.is_ok()) << beyond.status().message();
+  EXPECT_FALSE(capped);
+  EXPECT_GT(s2, 1.0);
+  Expected<Pose> from_rest = solve_pose_to(m, pattern, action, value, &cache, &s3, kMaxFapScale, &capped);
+  ASSERT_TRUE(from_rest.is_ok()) << from_rest.status().message();
+  EXPECT_NEAR(s2, s3, 1e-3 * s3);
+  EXPECT_NEAR(muscle_action(m.tissue, mu, beyond->X), value, 4 * m.solver.tolerance);
+  EXPECT_LT((pose_epidermis(m, *beyond) - pose_epidermis(m, *from_rest)).cwiseAbs().maxCoeff(), 4 * m.solver.tolerance);
+  // A budget too small to get there is a failure, not a pose short of it.
+  from.max_iterations = 1;
+  EXPECT_FALSE(solve_pose_to(m, pattern, action, value, &cache, &s2, kMaxFapScale, &capped, &from).is_ok());
 }
 
 TEST(FapSynthesis, TheSameOnAnyNumberOfThreads) {
