@@ -148,9 +148,10 @@ $(B)/tests/test_%: $$(call obj,$$(wildcard tests/$$*/*.cpp)) $(call obj,$(wildca
 	@mkdir -p $(@D)
 	$(CXX) $(filter %.o,$^) -o $@ $(LDFLAGS) $(CXX_LINK_LIBS) -lgtest -lgtest_main
 
+# zlib: the compressed baseline of bench_afm_size.
 $(B)/bench/%: $(B)/obj/bench/%.cpp.o $(LIBS)
 	@mkdir -p $(@D)
-	$(CXX) $< -o $@ $(LDFLAGS) $(CXX_LINK_LIBS)
+	$(CXX) $< -o $@ $(LDFLAGS) $(CXX_LINK_LIBS) -lz
 
 deps:
 	@tools/deps.sh

@@ -24,6 +24,8 @@
 #include "io/mesh_io.h"
 #include "refhead/refhead.h"
 
+#include "chunk_bytes.h"
+
 using namespace afmb;
 using Clock = std::chrono::steady_clock;
 
@@ -81,17 +83,6 @@ double seconds_per_load(const std::vector<uint8_t> &bytes) {
     elapsed = std::chrono::duration<double>(Clock::now() - t0).count();
   } while (elapsed < 0.3 || n < 3);
   return elapsed / n;
-}
-
-size_t chunk_bytes(const std::vector<uint8_t> &f, uint32_t kind) {
-  afm_container c;
-  if (afm_container_open(f.data(), f.size(), &c, nullptr) != AFM_OK) return 0;
-  for (uint32_t i = 0; i < c.chunk_count; ++i) {
-    afm_chunk_info ch;
-    afm_container_chunk(&c, i, &ch);
-    if (ch.kind == kind) return ch.length;
-  }
-  return 0;
 }
 
 void measure(const Model &m) {

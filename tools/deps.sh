@@ -6,7 +6,7 @@ set -eu
 PACKAGES="
   make g++ gcc pkg-config
   libeigen3-dev libopenmesh-dev libdraco-dev
-  libosmesa6-dev libglfw3-dev libgl-dev libpng-dev
+  libosmesa6-dev libglfw3-dev libgl-dev libpng-dev zlib1g-dev
   xvfb
   libgtest-dev
   gcc-arm-linux-gnueabi libc6-dev-armel-cross qemu-user
