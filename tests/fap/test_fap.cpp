@@ -390,14 +390,33 @@ TEST(FapSynthesis, AMissingMuscleIsAReportNotAnError) {
   EXPECT_TRUE(r->targets.empty());
 }
 
+// Zygomaticus major (left) alone at 100 %, steered by its own key node's
+// action: the pattern the steered-pose tests scale.
+struct Steered {
+  const Muscle *muscle = nullptr;
+  std::vector<std::pair<int, double>> pattern;
+  PoseAction action;
+};
+const Steered &zygomaticus() {
+  static Steered z;
+  if (!z.muscle) {
+    const FaceModel &m = head_1k().model;
+    const int i = m.find("zygomaticus_major_left");
+    const Muscle *mu = &m.muscles[static_cast<size_t>(i)];
+    z.pattern = {{i, 100.0}};
+    z.action = [&m, mu](const Eigen::MatrixXd &X, Eigen::MatrixXd *g) { return muscle_action(m.tissue, *mu, X, g); };
+    z.muscle = mu;
+  }
+  return z;
+}
+
 // A pose steered past what the group can do within its calibrated range
 // stops at scale 1: the same pose as the group at its table contractions.
 TEST(FapSynthesis, ASteeredPoseStopsAtTheCalibratedRange) {
   const FaceModel &m = head_1k().model;
-  const int i = m.find("zygomaticus_major_left");
-  const Muscle &mu = m.muscles[static_cast<size_t>(i)];
-  const std::vector<std::pair<int, double>> pattern = {{i, 100.0}};
-  PoseAction action = [&](const Eigen::MatrixXd &X, Eigen::MatrixXd *g) { return muscle_action(m.tissue, mu, X, g); };
+  const Muscle &mu = *zygomaticus().muscle;
+  const std::vector<std::pair<int, double>> &pattern = zygomaticus().pattern;
+  const PoseAction &action = zygomaticus().action;
   FactorCache cache;
   double scale = 0;
   bool capped = false;
@@ -425,10 +444,9 @@ TEST(FapSynthesis, ASteeredPoseStopsAtTheCalibratedRange) {
 // does not depend on where Newton started.
 TEST(FapSynthesis, ASteeredPoseFromTheRangesEndMeetsTheOneFromRest) {
   const FaceModel &m = head_1k().model;
-  const int i = m.find("zygomaticus_major_left");
-  const Muscle &mu = m.muscles[static_cast<size_t>(i)];
-  const std::vector<std::pair<int, double>> pattern = {{i, 100.0}};
-  PoseAction action = [&](const Eigen::MatrixXd &X, Eigen::MatrixXd *g) { return muscle_action(m.tissue, mu, X, g); };
+  const Muscle &mu = *zygomaticus().muscle;
+  const std::vector<std::pair<int, double>> &pattern = zygomaticus().pattern;
+  const PoseAction &action = zygomaticus().action;
   FactorCache cache;
   const double value = 1.5 * muscle_action_target(mu, true);
   double s1 = 0, s2 = 0, s3 = 0;
