@@ -60,7 +60,10 @@ void usage(FILE *out) {
       "  -o FACE.afm             synthesize the morph targets (each FAP, viseme and\n"
       "                          expression) and write the AFM; prints, per target, the\n"
       "                          prescribed and achieved FDP motion and the error along\n"
-      "                          and off the FAP's direction\n"
+      "                          and off the FAP's direction (a muscle group short of the\n"
+      "                          FAP's reference may pass its calibrated range, up to %g\n"
+      "                          times, while the skin stays a face; else the target\n"
+      "                          under-reaches, and says so)\n"
       "  --profile P             draco (default: compressed) or raw\n"
       "  --faps LIST             only these targets: FAP numbers, vN visemes, eN\n"
       "                          expressions, e.g. 3,12,31,v1,e1 (default: every mapped one)\n"
@@ -76,7 +79,7 @@ void usage(FILE *out) {
       "\n"
       "Exit status: 0 on success (FAPs that cannot be made are reported, not fatal), 1\n"
       "on bad input or a solve that does not converge (the message says which and\n"
-      "why), 2 on bad usage.\n");
+      "why), 2 on bad usage.\n", kMaxFapScale);
 }
 
 // One line on stderr, rewritten in place: "[done/total] what".
