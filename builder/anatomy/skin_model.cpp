@@ -1,8 +1,10 @@
 #include "anatomy/skin_model.h"
 
 #include <Eigen/Geometry>
+#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <unordered_map>
 
 namespace afmb {
@@ -40,6 +42,39 @@ double SkinModel::stiffness(const Spring &s) const {
   }
   return s.k;
 }
+
+namespace {
+
+// The least-squares sphere through points (#P x 3): |p|^2 = 2 c . p + k with
+// k = r^2 - |c|^2, linear in (c, k). None when the points are too few or
+// stray from it by more than a tenth of the radius (rms).
+std::optional<EyeSphere> fit_sphere(const Eigen::MatrixXd &P) {
+  if (P.rows() < 8) return std::nullopt;
+  Eigen::MatrixXd A(P.rows(), 4);
+  Eigen::VectorXd b(P.rows());
+  const Eigen::RowVector3d mean = P.colwise().mean();  // centred: better conditioned
+  for (Eigen::Index i = 0; i < P.rows(); ++i) {
+    const Eigen::RowVector3d p = P.row(i) - mean;
+    A.row(i) << 2 * p, 1.0;
+    b[i] = p.squaredNorm();
+  }
+  const Eigen::Vector4d x = A.colPivHouseholderQr().solve(b);
+  const Eigen::Vector3d c = x.head<3>();
+  const double r2 = x[3] + c.squaredNorm();
+  if (!(r2 > 0)) return std::nullopt;
+  EyeSphere s;
+  s.centre = c + mean.transpose();
+  s.radius = std::sqrt(r2);
+  double err = 0;
+  for (Eigen::Index i = 0; i < P.rows(); ++i) {
+    const double e = (P.row(i).transpose() - s.centre).norm() - s.radius;
+    err += e * e;
+  }
+  if (std::sqrt(err / static_cast<double>(P.rows())) > 0.1 * s.radius) return std::nullopt;
+  return s;
+}
+
+}  // namespace
 
 Expected<SkinModel> build_skin_model(const Scene &scene, int part, const TissueParams &params) {
   if (part < 0 || part >= static_cast<int>(scene.parts.size()))
@@ -183,6 +218,28 @@ Expected<SkinModel> build_skin_model(const Scene &scene, int part, const TissueP
                           (m.thickness[m.F(f, 0)] + m.thickness[m.F(f, 1)] + m.thickness[m.F(f, 2)]) / 3.0;
   }
   m.skull_free.assign(static_cast<size_t>(n), 0);
+
+  m.eye_of.assign(static_cast<size_t>(n), -1);
+  for (PartKind kind : {PartKind::EyeLeft, PartKind::EyeRight}) {
+    const int e = scene.find_kind(kind);
+    if (e < 0) continue;
+    std::optional<EyeSphere> ball = fit_sphere(scene.parts[static_cast<size_t>(e)].V);
+    if (!ball) continue;
+    ball->part = e;
+    const auto eye = static_cast<int8_t>(m.eyes.size());
+    m.eyes.push_back(*ball);
+    for (int v = 0; v < n; ++v) {
+      if (!m.in_mesh[static_cast<size_t>(v)] || m.eye_of[static_cast<size_t>(v)] >= 0) continue;
+      const Eigen::Vector3d q = m.X0.row(v).transpose() - ball->centre;
+      const double d = q.norm(), along = q.dot(m.normal.row(v).transpose());
+      // Inward along -normal, the line comes nearest the centre `along` in.
+      if (d < ball->radius || d > 1.5 * ball->radius || along <= 0) continue;
+      if (q.squaredNorm() - along * along < ball->radius * ball->radius) {
+        m.eye_of[static_cast<size_t>(v)] = eye;
+        m.skull_free[static_cast<size_t>(v)] = 1;
+      }
+    }
+  }
   return m;
 }
 

@@ -78,6 +78,13 @@ struct Spring {
   uint8_t slab = 0;   // 0..2; a layer spring reports its upper slab
 };
 
+// An eyeball the lids slide over: a sphere fitted to an eye part.
+struct EyeSphere {
+  int part = -1;                                     // scene part index
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // model units
+  double radius = 0;
+};
+
 struct SkinModel {
   int part = -1;           // the scene part the skin is
   int n = 0;               // nodes per surface (= the skin part's vertex count)
@@ -104,6 +111,15 @@ struct SkinModel {
   // reject its nodes.
   std::vector<uint8_t> skull_free;
   std::vector<uint8_t> in_mesh;  // per vertex: used by a triangle (others are never simulated)
+  // The eyeballs: spheres fitted to the scene's eye parts (an eye part whose
+  // vertices are not a sphere, within a tenth of its radius, is left out).
+  std::vector<EyeSphere> eyes;
+  // Per vertex: the eyeball it lies over, or -1. A vertex lies over an
+  // eyeball when it is outside the sphere at rest, within half a radius of
+  // its surface, and the line inward along its normal meets the sphere: the
+  // lids and the skin around them. The solver holds its epidermal node off
+  // the sphere instead of above the skull (what lies under a lid is the eye).
+  std::vector<int8_t> eye_of;
 
   int node(int layer, int vertex) const { return layer * n + vertex; }
   int layer_of(int node) const { return node / n; }
@@ -112,7 +128,8 @@ struct SkinModel {
   double stiffness(const Spring &s) const;
 };
 
-// Builds the tissue for scene part `part`. Fails when the part has no
+// Builds the tissue for scene part `part`; the scene's eye parts (if any)
+// become its eyeballs. Fails when the part has no
 // triangles, when its centre of gravity is on the surface (not a closed-ish
 // head), or when parameters are out of range (depths not 0 < d1 < d2 < 1,
 // skull_scale not in (0, 1)).

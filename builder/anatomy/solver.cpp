@@ -44,7 +44,8 @@ struct System {
   std::vector<int> local;  // global node -> local index, or -1
   std::vector<int> springs;
   std::vector<Element> elements;
-  std::vector<uint8_t> rejects;  // per local node
+  std::vector<uint8_t> rejects;  // per local node: held above its skull plane
+  std::vector<int8_t> eye;       // per local node: the eyeball (SkinModel::eyes) it is held off, or -1
   std::vector<std::vector<int>> adj;  // per local node: sorted block neighbours (itself included)
   std::vector<std::array<Block, 4>> spring_blocks;  // aa, bb, ab, ba
   std::vector<Block> element_blocks;                // 81 per element, (i, j) at 9 i + j
@@ -67,7 +68,10 @@ struct System {
         if (local[static_cast<size_t>(g)] >= 0) continue;
         local[static_cast<size_t>(g)] = static_cast<int>(nodes.size());
         nodes.push_back(g);
-        rejects.push_back(skull_rejects(m, v) ? 1 : 0);
+        // Over an eyeball the epidermis slides on the eye, not the bone.
+        const int8_t over = l == kEpidermis ? m.eye_of[static_cast<size_t>(v)] : int8_t(-1);
+        eye.push_back(over);
+        rejects.push_back(over < 0 && skull_rejects(m, v) ? 1 : 0);
       }
     }
     std::vector<uint8_t> seen(m.springs.size(), 0);
@@ -391,8 +395,10 @@ struct Contacts {
   }
 };
 
-// Puts penetrating nodes back on their skull plane and activates them.
-// Returns the largest correction.
+// Puts penetrating nodes back on their skull plane, or on the sphere of the
+// eyeball they lie over, and activates them. On an eyeball the constraint
+// plane is the sphere's tangent plane at the node, renewed at every update;
+// a held node is kept on the sphere. Returns the largest correction.
 double update_contacts(const System &sys, Eigen::MatrixXd &X, Contacts &c) {
   const SkinModel &m = sys.m;
   if (c.normal.rows() != static_cast<Eigen::Index>(sys.nodes.size()))
@@ -400,20 +406,38 @@ double update_contacts(const System &sys, Eigen::MatrixXd &X, Contacts &c) {
   double moved = 0;
   c.active = 0;
   for (size_t i = 0; i < sys.nodes.size(); ++i) {
-    if (!sys.rejects[i]) continue;
+    const Eigen::Index row = static_cast<Eigen::Index>(i);
+    // An active node stays active for the rest of the solve: releasing
+    // nodes the residual pulls off the bone makes the active set chatter.
+    const bool was = c.normal.row(row).squaredNorm() > 0;
     const int g = sys.nodes[i];
+    if (sys.eye[i] >= 0) {
+      const EyeSphere &e = m.eyes[static_cast<size_t>(sys.eye[i])];
+      const Eigen::Vector3d q = X.row(g).transpose() - e.centre;
+      const double d = q.norm();
+      if (!(d > 0)) continue;
+      const double gap = d - e.radius;
+      const bool on = was || gap < 0;
+      const Eigen::Vector3d nn = q / d;
+      if (on && gap != 0) {
+        X.row(g) -= gap * nn.transpose();
+        moved = std::max(moved, std::abs(gap));
+      }
+      c.normal.row(row) = on ? Eigen::RowVector3d(nn.transpose()) : Eigen::RowVector3d::Zero();
+      c.active += on;
+      continue;
+    }
+    if (!sys.rejects[i]) continue;
     const int v = m.vertex_of(g);
     const Eigen::Vector3d nn = m.normal.row(v);
     const Eigen::Vector3d skull = X.row(m.node(kSkull, v));
     const double gap = (X.row(g).transpose() - skull).dot(nn);
-    // An active node stays active for the rest of the solve: releasing
-    // nodes the residual pulls off the bone makes the active set chatter.
-    const bool on = c.normal.row(static_cast<Eigen::Index>(i)).squaredNorm() > 0 || gap < 0;
+    const bool on = was || gap < 0;
     if (gap < 0) {
       X.row(g) -= gap * nn.transpose();
       moved = std::max(moved, -gap);
     }
-    c.normal.row(static_cast<Eigen::Index>(i)) = on ? Eigen::RowVector3d(nn.transpose()) : Eigen::RowVector3d::Zero();
+    c.normal.row(row) = on ? Eigen::RowVector3d(nn.transpose()) : Eigen::RowVector3d::Zero();
     c.active += on;
   }
   return moved;

@@ -33,7 +33,11 @@
 //             once held stays held (releasing makes the active set
 //             chatter). Skull-free vertices and vertices whose surface
 //             faces the centre of gravity (lip curls, nostrils) are never
-//             constrained.
+//             constrained;
+//   eyeballs  the epidermal node of a vertex over an eyeball
+//             (SkinModel::eye_of) is held off its sphere the same way: put
+//             back on it when inside, then held with the sphere's tangent
+//             plane at the node, renewed at every update, as its plane.
 //
 // Solvers (bench_builder compares them; docs/anatomy.md has the figures):
 //   newton          Newton's method on the static equations. The step solves

@@ -12,6 +12,7 @@
 #include "afm/rigid_parts.h"
 #include "core/fapu.h"
 #include "core/parallel.h"
+#include "anatomy/skin_binding.h"
 #include "core/part_kind.h"
 #include "fap/fap_mapping.h"
 
@@ -102,6 +103,14 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
   out.jaw.pivot = model.jaw.pivot;
   for (PartKind k : {PartKind::TeethLower, PartKind::Tongue})
     if (int p = scene.find_kind(k); p >= 0) out.jaw.parts.push_back(p);
+  // Lashes and lid strips ride on the skin (skin_binding.h).
+  const std::vector<SkinBinding> carried = bind_to_skin(scene, model.skin, PartKind::Eyelid);
+  auto carry = [&carried](const Eigen::MatrixXd &D, MorphTarget &t) {
+    for (const SkinBinding &b : carried) {
+      Eigen::MatrixXd d = carried_displacement(b, D);
+      if (d.size() > 0 && d.cwiseAbs().maxCoeff() > 0) t.displacement[static_cast<size_t>(b.part)] = std::move(d);
+    }
+  };
 
   // Each target is its own solve: workers take them in turn, and the results
   // are put together in the work list's order, so the output does not depend
@@ -163,6 +172,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         t.reference = 63;
         t.displacement.assign(scene.parts.size(), Eigen::MatrixXd());
         t.displacement[static_cast<size_t>(model.skin)] = D;
+        carry(D, t);
         // No rigid control serves FAP 1 or 2: the jaw's parts move in the
         // target itself.
         if (!jaw.matrix().isIdentity(0))
@@ -367,6 +377,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       t.reference = o.reference;
       t.displacement.assign(scene.parts.size(), Eigen::MatrixXd());
       t.displacement[static_cast<size_t>(model.skin)] = D;
+      carry(D, t);
       res.target = std::move(t);
     }
     o.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

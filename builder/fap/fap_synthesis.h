@@ -10,6 +10,9 @@
 // the same rule, then solve the tissue around it; the jaw's rigid parts
 // (lower teeth, tongue) get a control with the same motion.
 //
+// Every target also carries the parts that ride on the skin (lashes, lid
+// and brow strips: skin_binding.h), by the skin's displacement under them.
+//
 // Visemes and expressions (fap_mapping.h, HighLevelMapping): the table's
 // muscles and jaw opening posed once; the target holds the skin and, when
 // the jaw opens, the jaw's rigid parts carried by it (these targets have no

@@ -269,6 +269,12 @@ int main(int argc, char **argv) {
   for (uint8_t f : t.skull_free) free_count += f;
   std::printf("  tissue thickness %.4g..%.4g, %d vertices not tied to the skull (lips, cheeks)\n",
               t.thickness.minCoeff(), t.thickness.maxCoeff(), free_count);
+  for (size_t e = 0; e < t.eyes.size(); ++e) {
+    int over = 0;
+    for (int8_t k : t.eye_of) over += k == static_cast<int8_t>(e);
+    std::printf("  eyeball '%s': radius %.4g, %d skin vertices slide on it (the lids)\n",
+                face->scene.parts[static_cast<size_t>(t.eyes[e].part)].name.c_str(), t.eyes[e].radius, over);
+  }
   std::printf("solver: %s, tolerance %.3g (half the AFM quantum %.3g), wave threshold %.3g\n",
               solver_name(model->solver.kind), model->solver.tolerance, model->quantum, model->wave_threshold);
   for (const std::string &n : model->notes) std::printf("note: %s\n", n.c_str());

@@ -14,6 +14,7 @@
 #include "anatomy/fdp_completion.h"
 #include "anatomy/muscle_table.h"
 #include "io/load_face.h"
+#include "refhead/head_shape.h"
 #include "refhead/refhead.h"
 #include "../common/reference_model.h"
 #include "../common/test_paths.h"
@@ -369,6 +370,48 @@ TEST(Physics, EachMuscleMovesItsRegionTheWayAnatomySays) {
     const double after = before + moved(m, X, "3.1").y() - moved(m, X, "3.3").y();
     EXPECT_LT(after, before - 0.2e-3) << "orbicularis oculi narrows the eye";
   }
+}
+
+// The lids ride over the eyeballs (skin_model.h): spheres fitted to the eye
+// parts, which the generator made as spheres of known centre and radius.
+// Closing the eye hard presses the upper lid onto its eyeball; without the
+// contact the same pull takes the lid into it.
+TEST(Physics, TheLidsSlideOverTheEyeball) {
+  const FaceModel &m = head_1k().model;
+  const refhead::HeadDesign &design = refhead::head_design();
+  ASSERT_EQ(m.tissue.eyes.size(), 2u);
+  for (int e = 0; e < 2; ++e) {
+    const EyeSphere &s = m.tissue.eyes[static_cast<size_t>(e)];
+    const Eigen::Vector3d c(e == 0 ? design.eye_centre.x() : -design.eye_centre.x(), design.eye_centre.y(),
+                            design.eye_centre.z());
+    EXPECT_LT((s.centre - c).norm(), 0.01 * design.eye_radius) << "eye " << e;
+    EXPECT_NEAR(s.radius, design.eye_radius, 0.01 * design.eye_radius) << "eye " << e;
+  }
+  const int top = m.fdps.find(*FdpId::parse("3.1"), m.skin)->vertex;  // the left upper lid
+  EXPECT_EQ(m.tissue.eye_of[static_cast<size_t>(top)], 0) << "FDP 3.1 lies over the left eyeball";
+  EXPECT_EQ(m.tissue.skull_free[static_cast<size_t>(top)], 1) << "a lid is not tied to the bone";
+
+  // The deepest any lid's epidermis goes into its eyeball, model units.
+  auto deepest = [&m](const Eigen::MatrixXd &X) {
+    double d = -1;
+    for (int v = 0; v < m.tissue.n; ++v)
+      if (const int e = m.tissue.eye_of[static_cast<size_t>(v)]; e >= 0) {
+        const EyeSphere &s = m.tissue.eyes[static_cast<size_t>(e)];
+        d = std::max(d, s.radius - (X.row(v).transpose() - s.centre).norm());
+      }
+    return d;
+  };
+  const double t = 2;  // the upper lid comes down about 3 mm
+  const Eigen::MatrixXd X = contract(m, "orbicularis_oculi_left", t);
+  EXPECT_LT(moved(m, X, "3.1").y(), -1e-3) << "the upper lid comes down";
+  EXPECT_LE(deepest(X), 1e-9) << "no lid enters its eyeball";
+  EXPECT_TRUE(X.allFinite());
+
+  FaceModel free = m;  // the same model without the eyeballs
+  free.tissue.eyes.clear();
+  std::fill(free.tissue.eye_of.begin(), free.tissue.eye_of.end(), int8_t(-1));
+  const Eigen::MatrixXd Y = contract(free, "orbicularis_oculi_left", t);
+  EXPECT_GT(deepest(Y), 0.05 * design.eye_radius) << "without the contact the lid goes into the eye";
 }
 
 TEST(Physics, TheJawOpens) {

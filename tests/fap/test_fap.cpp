@@ -16,6 +16,7 @@
 #include "anatomy/face_model.h"
 #include "anatomy/muscle_table.h"
 #include "anatomy/muscles.h"
+#include "anatomy/skin_binding.h"
 #include "anatomy/solver.h"
 #include "core/part_kind.h"
 #include "core/fapu.h"
@@ -292,6 +293,110 @@ TEST(HighLevel, JoyRaisesTheMouthCornerAndSadnessLowersIt) {
   EXPECT_TRUE(o->made);
   EXPECT_NE(o->message.find("zygomaticus_major_right"), std::string::npos) << o->message;
   EXPECT_GT(o->largest, j.norm() - 1e-12);
+}
+
+// The nearest point of a triangle, against the best of a dense sampling of
+// it: the same distance (to the sampling's resolution), never farther.
+TEST(SkinBinding, NearestPointOnATriangleBeatsDenseSampling) {
+  const Eigen::Vector3d tri[4][3] = {
+      {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}},
+      {{0.2, -0.3, 0.1}, {1.1, 0.4, -0.2}, {-0.5, 0.9, 0.6}},
+      {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}},           // degenerate: a segment
+      {{0, 0, 0}, {3, 0.01, 0}, {0, 0.02, 1e-3}}};  // a sliver
+  std::srand(7);
+  auto rnd = [] { return 4.0 * std::rand() / RAND_MAX - 2.0; };
+  for (const auto &t : tri)
+    for (int k = 0; k < 40; ++k) {
+      const Eigen::Vector3d p(rnd(), rnd(), rnd());
+      const Eigen::Vector3d w = nearest_on_triangle(p, t[0], t[1], t[2]);
+      EXPECT_GE(w.minCoeff(), 0);
+      EXPECT_NEAR(w.sum(), 1, 1e-12);
+      const double d = (w[0] * t[0] + w[1] * t[1] + w[2] * t[2] - p).norm();
+      double best = 1e300;
+      const int n = 400;
+      for (int i = 0; i <= n; ++i)
+        for (int j = 0; i + j <= n; ++j) {
+          const double a = double(i) / n, b = double(j) / n;
+          best = std::min(best, ((1 - a - b) * t[0] + a * t[1] + b * t[2] - p).norm());
+        }
+      EXPECT_LE(d, best + 1e-12);
+      EXPECT_GT(d, best - 3.0 / n);
+    }
+}
+
+// A brow strip (PartKind::Eyelid, as lashes and lid strips) rides on the
+// skin: raising the brow (FAP 33) carries it up with the brow, and it keeps
+// its offset from the moved skin.
+TEST(SkinBinding, ABrowStripRidesOnTheSkinAsTheBrowRises) {
+  const FaceModel &m = head_1k().model;
+  Scene scene = head_1k().head.scene;
+  const Part skin = scene.parts[static_cast<size_t>(m.skin)];  // a copy: parts grows below
+  const FdpPoint *brow = m.fdps.find(FdpId{4, 3}, m.skin);
+  ASSERT_NE(brow, nullptr);
+  // The skin triangles within 20 mm of 4.3, lifted 0.3 mm off the skin.
+  const double offset = 0.3e-3;
+  Part strip;
+  strip.name = "brow_strip";
+  strip.kind = PartKind::Eyelid;
+  std::vector<int> index(static_cast<size_t>(skin.V.rows()), -1);
+  std::vector<Eigen::Vector3i> faces;
+  std::vector<Eigen::RowVector3d> points;
+  for (Eigen::Index f = 0; f < skin.F.rows(); ++f) {
+    Eigen::Vector3i face;
+    bool near = true;
+    for (int k = 0; k < 3; ++k) near = near && (skin.V.row(skin.F(f, k)).transpose() - brow->pos).norm() < 20e-3;
+    if (!near) continue;
+    for (int k = 0; k < 3; ++k) {
+      int &i = index[static_cast<size_t>(skin.F(f, k))];
+      if (i < 0) {
+        i = static_cast<int>(points.size());
+        points.push_back(skin.V.row(skin.F(f, k)) + offset * m.tissue.normal.row(skin.F(f, k)));
+      }
+      face[k] = i;
+    }
+    faces.push_back(face);
+  }
+  ASSERT_GT(faces.size(), 10u);
+  strip.V.resize(static_cast<Eigen::Index>(points.size()), 3);
+  for (size_t i = 0; i < points.size(); ++i) strip.V.row(static_cast<Eigen::Index>(i)) = points[i];
+  strip.F.resize(static_cast<Eigen::Index>(faces.size()), 3);
+  for (size_t i = 0; i < faces.size(); ++i) strip.F.row(static_cast<Eigen::Index>(i)) = faces[i].transpose();
+  scene.parts.push_back(strip);
+  const size_t part = scene.parts.size() - 1;
+
+  FapSynthesisOptions o;
+  o.only = {33};
+  o.negative_sides = false;
+  Expected<FapSynthesis> s = synthesize_faps(scene, m, o);
+  ASSERT_TRUE(s.is_ok()) << s.status().message();
+  ASSERT_EQ(s->targets.size(), 1u);
+  const MorphTarget &t = s->targets[0];
+  const Eigen::MatrixXd &D = t.displacement[static_cast<size_t>(m.skin)];
+  ASSERT_EQ(t.displacement[part].rows(), strip.V.rows()) << "the strip moves in the target";
+  const Eigen::MatrixXd moved_strip = strip.V + t.displacement[part];
+  const Eigen::MatrixXd moved_skin = skin.V + D;
+  ASSERT_TRUE(moved_strip.allFinite());
+  const double rise = D(brow->vertex, 1);
+  ASSERT_GT(rise, 1e-3);
+  // The distance of each strip vertex to the skin, over all its triangles.
+  auto distance = [&skin](const Eigen::MatrixXd &S, const Eigen::Vector3d &p) {
+    double d = 1e300;
+    for (Eigen::Index f = 0; f < skin.F.rows(); ++f) {
+      const Eigen::Vector3d a = S.row(skin.F(f, 0)), b = S.row(skin.F(f, 1)), c = S.row(skin.F(f, 2));
+      const Eigen::Vector3d w = nearest_on_triangle(p, a, b, c);
+      d = std::min(d, (w[0] * a + w[1] * b + w[2] * c - p).norm());
+    }
+    return d;
+  };
+  for (Eigen::Index v = 0; v < strip.V.rows(); ++v) {
+    const double before = distance(skin.V, strip.V.row(v).transpose());
+    const double after = distance(moved_skin, moved_strip.row(v).transpose());
+    EXPECT_NEAR(after, before, 0.1 * offset) << "strip vertex " << v;  // while it moves mm
+  }
+  // The strip vertex over 4.3 rises with it.
+  const Eigen::Index over = index[static_cast<size_t>(brow->vertex)];
+  ASSERT_GE(over, 0);
+  EXPECT_NEAR(t.displacement[part](over, 1), rise, 0.1 * rise);
 }
 
 // No target folds the skin or sinks it into the skull: every epidermis
