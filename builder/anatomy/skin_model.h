@@ -106,7 +106,7 @@ struct SkinModel {
   Eigen::VectorXd nominal_volume;
   std::vector<std::vector<int>> neighbours;    // n: vertex adjacency of the skin mesh
   std::vector<std::vector<int>> vertex_faces;  // n: triangles at each vertex
-  // Per vertex: 1 = not tied to the bone (lips, cheeks): its springs from
+  // Per vertex: 1 = not tied to the bone (lips, cheeks; lids over an eyeball): its springs from
   // the hypodermis to the skull have zero stiffness and the skull does not
   // reject its nodes.
   std::vector<uint8_t> skull_free;
