@@ -10,9 +10,9 @@
 #include <optional>
 
 #include "afm/rigid_parts.h"
+#include "anatomy/skin_binding.h"
 #include "core/fapu.h"
 #include "core/parallel.h"
-#include "anatomy/skin_binding.h"
 #include "core/part_kind.h"
 #include "fap/fap_mapping.h"
 

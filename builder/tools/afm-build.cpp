@@ -267,7 +267,7 @@ int main(int argc, char **argv) {
               static_cast<long long>(t.F.rows()), t.springs.size(), counts[0], counts[1], counts[2]);
   int free_count = 0;
   for (uint8_t f : t.skull_free) free_count += f;
-  std::printf("  tissue thickness %.4g..%.4g, %d vertices not tied to the skull (lips, cheeks)\n",
+  std::printf("  tissue thickness %.4g..%.4g, %d vertices not tied to the skull (lips, cheeks, lids)\n",
               t.thickness.minCoeff(), t.thickness.maxCoeff(), free_count);
   for (size_t e = 0; e < t.eyes.size(); ++e) {
     int over = 0;
