@@ -402,6 +402,19 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
   return out;
 }
 
+void lift_synthesis(FapSynthesis &synthesis, const SimMesh &sim) {
+  if (!sim.decimated) return;
+  const size_t skin = static_cast<size_t>(sim.skin);
+  size_t next = 0;  // targets are the made outcomes, in order
+  for (FapOutcome &o : synthesis.outcomes) {
+    if (!o.made) continue;
+    MorphTarget &t = synthesis.targets[next++];
+    if (skin >= t.displacement.size() || t.displacement[skin].rows() == 0) continue;
+    t.displacement[skin] = lift_displacement(sim, t.displacement[skin]);
+    if (o.kind != AFM_TARGET_FAP) o.largest = t.displacement[skin].rowwise().norm().maxCoeff();
+  }
+}
+
 AfmContent fap_afm_content(const Scene &scene, const FdpSet &fdps, const FaceModel &model, FapSynthesis synthesis) {
   AfmContent c;
   c.scene = &scene;

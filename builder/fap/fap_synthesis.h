@@ -47,6 +47,7 @@
 
 #include "afm/afm_export.h"
 #include "anatomy/face_model.h"
+#include "anatomy/sim_mesh.h"
 #include "core/status.h"
 
 namespace afmb {
@@ -101,6 +102,12 @@ struct FapSynthesis {
 // outcome with made = false.
 Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &model,
                                        const FapSynthesisOptions &options = {});
+
+// Carries a synthesis made on a simulation mesh (sim_mesh.h: the model built
+// on sim_scene) to the skin: every target's skin displacement becomes #V x 3
+// over the skin's own vertices, and the `largest` of each viseme and
+// expression is measured there. Nothing changes when the simulation mesh is the skin.
+void lift_synthesis(FapSynthesis &synthesis, const SimMesh &sim);
 
 // The AFM's content: the scene, its input FDPs (bound to `scene`; not the
 // model's estimates), the model's FAPU, the synthesis' targets, the eye and

@@ -69,11 +69,11 @@ std::string csv_quote(const std::string &s) {
 }
 
 // The FDP a FAP target is measured at (skin vertex), or -1.
-int fap_fdp_vertex(const FaceModel &model, const FapOutcome &o) {
+int fap_fdp_vertex(const FdpSet &fdps, int skin, const FapOutcome &o) {
   if (o.kind != AFM_TARGET_FAP) return -1;
   const afm_fap_info *info = afm_fap(o.number);
-  const FdpPoint *p = info ? model.fdps.find(FdpId{info->fdp_group, info->fdp_index}, model.skin) : nullptr;
-  return p && p->part == model.skin ? p->vertex : -1;
+  const FdpPoint *p = info ? fdps.find(FdpId{info->fdp_group, info->fdp_index}, skin) : nullptr;
+  return p && p->part == skin ? p->vertex : -1;
 }
 
 // The jaw's rigid motion at a jaw FAP's reference value (identity for other
@@ -138,7 +138,7 @@ std::string fidelity_table(const FapSynthesis &s) {
   return out;
 }
 
-Status write_fidelity_report(const std::string &dir, const Scene &scene, const FaceModel &model,
+Status write_fidelity_report(const std::string &dir, const Scene &scene, const FdpSet &fdps, int skin_index,
                              const FapSynthesis &s, const FidelityReportOptions &options) {
   namespace fs = std::filesystem;
   std::error_code ec;
@@ -168,7 +168,7 @@ Status write_fidelity_report(const std::string &dir, const Scene &scene, const F
   ro.views = {SceneView{}};
   ro.face_closeup = true;
   ro.fdp_dot_pixels = 0;
-  const size_t skin = static_cast<size_t>(model.skin);
+  const size_t skin = static_cast<size_t>(skin_index);
   const Part &skin_part = scene.parts[skin];
   Eigen::MatrixXd base = skin_part.C;
   if (base.rows() != skin_part.V.rows()) base = skin_part.diffuse.transpose().replicate(skin_part.V.rows(), 1);
@@ -178,7 +178,7 @@ Status write_fidelity_report(const std::string &dir, const Scene &scene, const F
   const int total = 1 + static_cast<int>(s.targets.size());
   auto picture = [&](const std::string &stem, const Scene &posed, const std::vector<SceneMarkers> &markers) -> Status {
     ro.markers = markers;
-    Expected<std::vector<std::vector<uint8_t>>> img = render_scene(posed, &model.fdps, ro);
+    Expected<std::vector<std::vector<uint8_t>>> img = render_scene(posed, &fdps, ro);
     if (!img) return img.status().wrap(dir + sep + "targets" + sep + stem + ".png");
     const std::string path = dir + sep + "targets" + sep + stem + ".png";
     afm_render_image image{img->front().data(), ro.width, ro.height};
@@ -217,7 +217,7 @@ Status write_fidelity_report(const std::string &dir, const Scene &scene, const F
       posed.parts[skin].C = C;
     }
     std::vector<SceneMarkers> markers;
-    if (const int v = fap_fdp_vertex(model, o); v >= 0) {
+    if (const int v = fap_fdp_vertex(fdps, skin_index, o); v >= 0) {
       const Eigen::RowVector3d rest = skin_part.V.row(v);
       SceneMarkers at, goal;
       at.points = rest;

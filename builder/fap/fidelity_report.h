@@ -20,7 +20,7 @@
 #include <functional>
 #include <string>
 
-#include "anatomy/face_model.h"
+#include "core/fdp.h"
 #include "core/scene.h"
 #include "core/status.h"
 #include "fap/fap_synthesis.h"
@@ -42,10 +42,12 @@ struct FidelityReportOptions {
   std::function<void(int done, int total, const std::string &what)> progress;
 };
 
-// Writes the report of `synthesis`, made from `model` (built from `scene`),
-// into `dir`. Fails when the directory cannot be made or a file written, or
-// a picture cannot be rendered; the message names the file.
-Status write_fidelity_report(const std::string &dir, const Scene &scene, const FaceModel &model,
+// Writes the report of `synthesis` into `dir`. Its targets move `scene`;
+// `fdps` are the model's (the input's and its estimates) bound to `scene`,
+// and `skin` is the skin's part index. Fails when the directory cannot be
+// made or a file written, or a picture cannot be rendered; the message
+// names the file.
+Status write_fidelity_report(const std::string &dir, const Scene &scene, const FdpSet &fdps, int skin,
                              const FapSynthesis &synthesis, const FidelityReportOptions &options = {});
 
 }  // namespace afmb

@@ -10,6 +10,7 @@
 #include "afm/afm_export.h"
 #include "anatomy/face_model.h"
 #include "anatomy/muscle_table.h"
+#include "anatomy/sim_mesh.h"
 #include "fap/fap_mapping.h"
 #include "fap/fap_synthesis.h"
 #include "fap/fidelity_report.h"
@@ -41,6 +42,14 @@ void usage(FILE *out) {
       "  --solver S              newton (default), newton-rest, implicit-euler (the\n"
       "                          paper's scheme) or newton-jacobi (solver.h; calibration\n"
       "                          always runs a newton solver)\n"
+      "  --sim-vertices N|full   simulate on a coarser copy of the skin of about N\n"
+      "                          vertices (its own, every skin FDP among them; finer\n"
+      "                          around eyes and mouth) and carry the motion to every\n"
+      "                          skin vertex (default %d; full: the skin itself, as is\n"
+      "                          any skin of at most 1.25 N vertices). The\n"
+      "                          pictures of the model show the simulation mesh. A\n"
+      "                          mesh too coarse to calibrate an essential muscle is\n"
+      "                          tried again 1.5 times as fine, up to the whole skin\n"
       "  --threads N             calibration and synthesis workers (default: one per\n"
       "                          core; the model and the AFM are the same for any N)\n"
       "  --no-estimates          do not estimate missing FDPs from the reference head:\n"
@@ -79,7 +88,7 @@ void usage(FILE *out) {
       "\n"
       "Exit status: 0 on success (FAPs that cannot be made are reported, not fatal), 1\n"
       "on bad input or a solve that does not converge (the message says which and\n"
-      "why), 2 on bad usage.\n", kMaxFapScale);
+      "why), 2 on bad usage.\n", kDefaultSimVertices, kMaxFapScale);
 }
 
 // One line on stderr, rewritten in place: "[done/total] what".
@@ -112,6 +121,8 @@ int main(int argc, char **argv) {
   std::string out_path, report_dir;
   afm_profile profile = AFM_PROFILE_DRACO;
   FapSynthesisOptions so;
+  SimMeshOptions sm;
+  sm.vertices = kDefaultSimVertices;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&](const char *name) -> std::string {
@@ -145,6 +156,14 @@ int main(int argc, char **argv) {
       const long n = std::strtol(t.c_str(), &end, 10);
       if (t.empty() || *end || n < 1 || n > 256) return usage_error("--threads '" + t + "': use a count, 1..256");
       fo.threads = static_cast<int>(n);
+    } else if (a == "--sim-vertices") {
+      const std::string t = value("--sim-vertices");
+      char *end = nullptr;
+      const long n = std::strtol(t.c_str(), &end, 10);
+      if (t == "full") sm.vertices = 0;
+      else if (t.empty() || *end || n < 200 || n > 10000000)
+        return usage_error("--sim-vertices '" + t + "': use a vertex count of at least 200, or full");
+      else sm.vertices = static_cast<int>(n);
     } else if (a == "--no-estimates") {
       fo.estimate_missing_fdps = false;
     } else if (a == "--no-calibrate") {
@@ -253,17 +272,28 @@ int main(int argc, char **argv) {
   for (const std::string &line : log) std::printf("%s\n", line.c_str());
   if (!face) return fail(face.status());
 
+  // The model on the simulation mesh (retried finer if it cannot be built).
   if (!quiet) fo.progress = progress_line;
-  Expected<FaceModel> model = build_face_model(face->scene, face->fdps, fo);
+  int meshes = 0;
+  Expected<SimFaceModel> built = build_sim_face_model(face->scene, face->fdps, sm, fo, [&](const SimMesh &m) {
+    if (!quiet && meshes++ > 0) std::fprintf(stderr, "\n");  // after the failed build's progress
+    if (m.decimated)
+      std::printf("simulation mesh: %zu of the skin's %lld vertices, %lld triangles (%.2f s)\n", m.kept.size(),
+                  static_cast<long long>(m.binding.corner.rows()), static_cast<long long>(m.F.rows()), m.seconds);
+  });
   if (!quiet) std::fprintf(stderr, "\n");
-  if (!model) return fail(model.status().wrap(mesh_path));
+  if (!built) return fail(built.status().wrap(mesh_path));
+  for (const std::string &n : built->notes) std::printf("note: %s\n", n.c_str());
+  const SimMesh *sim = &built->sim;
+  const Scene &scene = built->scene;
+  const FaceModel *model = &built->model;
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   const SkinModel &t = model->tissue;
   int counts[3] = {0, 0, 0};
   for (const Spring &s : t.springs) counts[static_cast<int>(s.kind)]++;
   std::printf("skin: part '%s', %d vertices, %lld elements, %zu springs (layer %d, connecting %d, crossed %d)\n",
-              face->scene.parts[static_cast<size_t>(model->skin)].name.c_str(), t.n,
+              scene.parts[static_cast<size_t>(model->skin)].name.c_str(), t.n,
               static_cast<long long>(t.F.rows()), t.springs.size(), counts[0], counts[1], counts[2]);
   int free_count = 0;
   for (uint8_t f : t.skull_free) free_count += f;
@@ -273,11 +303,12 @@ int main(int argc, char **argv) {
     int over = 0;
     for (int8_t k : t.eye_of) over += k == static_cast<int8_t>(e);
     std::printf("  eyeball '%s': radius %.4g, %d skin vertices slide on it (the lids)\n",
-                face->scene.parts[static_cast<size_t>(t.eyes[e].part)].name.c_str(), t.eyes[e].radius, over);
+                scene.parts[static_cast<size_t>(t.eyes[e].part)].name.c_str(), t.eyes[e].radius, over);
   }
   std::printf("solver: %s, tolerance %.3g (half the AFM quantum %.3g), wave threshold %.3g\n",
               solver_name(model->solver.kind), model->solver.tolerance, model->quantum, model->wave_threshold);
-  for (const std::string &n : model->notes) std::printf("note: %s\n", n.c_str());
+  for (const std::string &n : model->notes)
+    std::printf("note: %s%s\n", n.c_str(), sim->decimated ? " (of the simulation mesh)" : "");
   for (const std::string &w : model->warnings) std::printf("warning: %s\n", w.c_str());
   std::printf("%-26s %9s %8s %8s %11s %11s\n", "muscle", "length", "area", "V_d", "tension+", "tension-");
   for (const Muscle &m : model->muscles)
@@ -292,17 +323,17 @@ int main(int argc, char **argv) {
   std::printf("built in %.2f s\n", seconds);
 
   if (!muscle_map.empty()) {
-    if (Status s = render_muscle_map_png(face->scene, *model, muscle_map); !s) return fail(s);
+    if (Status s = render_muscle_map_png(scene, *model, muscle_map); !s) return fail(s);
     std::printf("wrote %s\n", muscle_map.c_str());
   }
   for (const auto &[name, path] : influences) {
     const int i = model->find(name);
     if (i < 0) return fail(Status::error("--influence: muscle " + name + " was skipped (see the warnings)"));
-    if (Status s = render_influence_png(face->scene, *model, i, path); !s) return fail(s);
+    if (Status s = render_influence_png(scene, *model, i, path); !s) return fail(s);
     std::printf("wrote %s\n", path.c_str());
   }
   if (!jaw_map.empty()) {
-    if (Status s = render_jaw_map_png(face->scene, *model, jaw_map); !s) return fail(s);
+    if (Status s = render_jaw_map_png(scene, *model, jaw_map); !s) return fail(s);
     std::printf("wrote %s\n", jaw_map.c_str());
   }
   if (!contractions.empty() || jaw_open > 0) {
@@ -327,7 +358,7 @@ int main(int argc, char **argv) {
                 pose->dynamic.size(), pose->stats.iterations, pose->stats.cg_iterations, pose->stats.seconds,
                 worst, at);
     if (!pose_png.empty()) {
-      if (Status s = render_pose_png(face->scene, *model, *pose, jaw_motion(model->jaw, jaw_open, 0, 0), pose_png); !s)
+      if (Status s = render_pose_png(scene, *model, *pose, jaw_motion(model->jaw, jaw_open, 0, 0), pose_png); !s)
         return fail(s);
       std::printf("wrote %s\n", pose_png.c_str());
     }
@@ -336,13 +367,14 @@ int main(int argc, char **argv) {
     const auto t1 = std::chrono::steady_clock::now();
     if (!quiet) so.progress = progress_line;
     so.threads = fo.threads;
-    Expected<FapSynthesis> syn = synthesize_faps(face->scene, *model, so);
+    Expected<FapSynthesis> syn = synthesize_faps(scene, *model, so);
     if (!syn) return fail(syn.status());
+    lift_synthesis(*syn, *sim);
     std::printf("%s", fidelity_table(*syn).c_str());
     if (!report_dir.empty()) {
       FidelityReportOptions ro;
       if (!quiet) ro.progress = progress_line;
-      if (Status st = write_fidelity_report(report_dir, face->scene, *model, *syn, ro); !st) return fail(st);
+      if (Status st = write_fidelity_report(report_dir, face->scene, lift_fdps(model->fdps, *sim), model->skin, *syn, ro); !st) return fail(st);
       std::printf("wrote the fidelity report into %s/ (index.html, sheet.png, report.txt, report.csv)\n",
                   report_dir.c_str());
     }

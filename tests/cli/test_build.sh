@@ -44,6 +44,22 @@ size=$(od -An -tu1 -j16 -N8 "$r/sheet.png" | awk '{ printf "%dx%d", $3 * 256 + $
 grep -q "FAP  *3  *open_jaw  *320" "$tmp/info.txt" || fail "afm-info lists no open_jaw target: $(cat "$tmp/info.txt")"
 grep -qi "viseme  *10 " "$tmp/info.txt" || fail "afm-info lists no viseme 10: $(cat "$tmp/info.txt")"
 
+# A skin of 2,000 vertices is simulated on 1,000 of them (the default) and
+# its targets carried back to all of them.
+"$gen" --vertices 2000 -o "$tmp/h2.wrl" >/dev/null 2>&1 || fail "afm-headgen --vertices 2000 failed"
+"$bin" "$tmp/h2.wrl" "$tmp/h2.fdp" -q --faps 12 -o "$tmp/h2.afm" >"$tmp/h2.txt" 2>&1 ||
+  fail "the 2k build failed: $(tail -n 5 "$tmp/h2.txt")"
+grep -q "^simulation mesh: 1000 of the skin's [0-9]* vertices" "$tmp/h2.txt" ||
+  fail "no simulation mesh line: $(head -n 3 "$tmp/h2.txt")"
+grep -q "^skin: part 'skin', 1000 vertices" "$tmp/h2.txt" || fail "the model is not built on 1,000 vertices"
+skin=$(sed -n "s/^simulation mesh: 1000 of the skin's \([0-9]*\) vertices.*/\1/p" "$tmp/h2.txt")
+"$info" "$tmp/h2.afm" >"$tmp/h2info.txt" 2>&1 || fail "afm-info cannot read the 2k AFM"
+# (The AFM splits vertices at texture seams: at least the input's count.)
+stored=$(awk '$1 == "skin" && $2 == "skin" { print $3 }' "$tmp/h2info.txt")
+[ -n "$stored" ] && [ "$stored" -ge "$skin" ] || fail "the AFM's skin has ${stored:-no} vertices, not the input's $skin"
+grep -q "^targets: 2 made" "$tmp/h2.txt" || fail "FAP 12's two sides not made: $(tail -n 2 "$tmp/h2.txt")"
+expect_error "bad simulation size" 2 "at least 200, or full" - -- "$bin" "$tmp/h2.wrl" "$tmp/h2.fdp" --sim-vertices 50
+
 # Placement only: the summary and three pictures.
 "$bin" "$tmp/h.wrl" "$tmp/h.fdp" --no-calibrate -q --muscle-map "$tmp/map.png" \
   --influence zygomaticus_major_left "$tmp/zyg.png" --jaw-map "$tmp/jaw.png" >"$tmp/out.txt" 2>&1 ||

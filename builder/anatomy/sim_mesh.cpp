@@ -1,0 +1,344 @@
+// OpenMesh's VectorT default constructor leaves its elements uninitialised on
+// purpose, and GCC 12 flags the copies its property arrays make of them
+// (inside the standard headers, so the pragma has to precede every include).
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+
+#include "anatomy/sim_mesh.h"
+
+#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
+#include <OpenMesh/Tools/Decimater/DecimaterT.hh>
+#include <OpenMesh/Tools/Decimater/ModAspectRatioT.hh>
+#include <OpenMesh/Tools/Decimater/ModBaseT.hh>
+#include <OpenMesh/Tools/Decimater/ModHausdorffT.hh>
+#include <OpenMesh/Tools/Decimater/ModNormalDeviationT.hh>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <queue>
+#include <string>
+#include <utility>
+
+namespace afmb {
+
+namespace {
+
+struct Traits : OpenMesh::DefaultTraits {
+  typedef OpenMesh::Vec3d Point;
+  typedef OpenMesh::Vec3d Normal;
+};
+using TriMesh = OpenMesh::TriMesh_ArrayKernelT<Traits>;
+
+// The sizing around the eyes and the mouth, relative to elsewhere: edges
+// there count twice as long, so the lids and lips keep about four times the
+// vertex density.
+constexpr double kFeatureSizing = 0.5;
+// How far, in eye separations, the finer sizing reaches from the nearest
+// eye or lip FDP (it grows linearly back to 1 over that distance).
+constexpr double kFeatureReach = 0.3;
+// What a collapse may not do: turn a coarse triangle's normal further than
+// this from the skin normals it covers, or leave a skin vertex farther than
+// kMaxDistance eye separations from the coarse surface.
+constexpr double kMaxNormalTurnDegrees = 60;
+constexpr double kMaxDistance = 0.03;
+constexpr float kMaxAspectRatio = 5;
+
+// Priority: the edge's squared length over the squared sizing at its
+// midpoint (shortest first). Not binary: it orders the collapses.
+template <class MeshT>
+class ModSizedLengthT : public OpenMesh::Decimater::ModBaseT<MeshT> {
+ public:
+  DECIMATING_MODULE(ModSizedLengthT, MeshT, SizedLength);
+
+  explicit ModSizedLengthT(MeshT &mesh) : Base(mesh, false) {}
+
+  std::function<double(const Eigen::Vector3d &)> sizing;
+
+  float collapse_priority(const CollapseInfo &ci) override {
+    const Eigen::Vector3d p0(ci.p0[0], ci.p0[1], ci.p0[2]), p1(ci.p1[0], ci.p1[1], ci.p1[2]);
+    const double h = sizing((p0 + p1) / 2);
+    return static_cast<float>((p1 - p0).squaredNorm() / (h * h));
+  }
+};
+
+bool is_feature(const FdpId &id) {
+  return id.group == 3 || id.group == 8 || (id.group == 2 && id.index >= 2 && id.index <= 9);
+}
+
+// For every skin vertex, the kept vertex nearest along the skin's edges
+// (-1 where none is reachable), by Dijkstra from all kept vertices at once.
+std::vector<int> nearest_kept(const Part &skin, const std::vector<int> &kept) {
+  const int n = static_cast<int>(skin.V.rows());
+  std::vector<std::vector<int>> adj(static_cast<size_t>(n));
+  for (Eigen::Index f = 0; f < skin.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = skin.F(f, k), b = skin.F(f, (k + 1) % 3);
+      adj[static_cast<size_t>(a)].push_back(b);
+      adj[static_cast<size_t>(b)].push_back(a);
+    }
+  std::vector<double> dist(static_cast<size_t>(n), std::numeric_limits<double>::infinity());
+  std::vector<int> label(static_cast<size_t>(n), -1);
+  using Item = std::pair<double, int>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+  for (size_t c = 0; c < kept.size(); ++c) {
+    dist[static_cast<size_t>(kept[c])] = 0;
+    label[static_cast<size_t>(kept[c])] = static_cast<int>(c);
+    queue.emplace(0.0, kept[c]);
+  }
+  while (!queue.empty()) {
+    const auto [d, v] = queue.top();
+    queue.pop();
+    if (d > dist[static_cast<size_t>(v)]) continue;
+    for (int u : adj[static_cast<size_t>(v)]) {
+      const double du = d + (skin.V.row(u) - skin.V.row(v)).norm();
+      // Ties go to the lower coarse index, so the labels do not depend on
+      // the order the queue pops equal distances in.
+      if (du < dist[static_cast<size_t>(u)] ||
+          (du == dist[static_cast<size_t>(u)] && label[static_cast<size_t>(v)] < label[static_cast<size_t>(u)])) {
+        dist[static_cast<size_t>(u)] = du;
+        label[static_cast<size_t>(u)] = label[static_cast<size_t>(v)];
+        queue.emplace(du, u);
+      }
+    }
+  }
+  return label;
+}
+
+// Binds every skin vertex to the coarse mesh (see the header).
+SkinBinding bind_fine_to_coarse(const Part &skin, const SimMesh &sim) {
+  const int n = static_cast<int>(skin.V.rows());
+  const int nc = static_cast<int>(sim.V.rows());
+  std::vector<std::vector<int>> faces_of(static_cast<size_t>(nc));  // coarse faces at each coarse vertex
+  for (Eigen::Index f = 0; f < sim.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) faces_of[static_cast<size_t>(sim.F(f, k))].push_back(static_cast<int>(f));
+  std::vector<int> coarse_of(static_cast<size_t>(n), -1);
+  for (int c = 0; c < nc; ++c) coarse_of[static_cast<size_t>(sim.kept[static_cast<size_t>(c)])] = c;
+  const std::vector<int> label = nearest_kept(skin, sim.kept);
+
+  SkinBinding b;
+  b.part = sim.skin;
+  b.corner.resize(n, 3);
+  b.weight.resize(n, 3);
+  std::vector<int> candidates;
+  std::vector<uint8_t> seen(static_cast<size_t>(sim.F.rows()), 0);
+  for (int v = 0; v < n; ++v) {
+    const int self = coarse_of[static_cast<size_t>(v)];
+    if (self >= 0 && !faces_of[static_cast<size_t>(self)].empty()) {
+      const int f = faces_of[static_cast<size_t>(self)].front();
+      b.corner.row(v) = sim.F.row(f);
+      for (int k = 0; k < 3; ++k) b.weight(v, k) = sim.F(f, k) == self ? 1.0 : 0.0;
+      continue;
+    }
+    // The coarse triangles around the nearest kept vertex and its coarse
+    // neighbours; every coarse triangle when no kept vertex is reachable
+    // (a skin component the decimation left without one).
+    candidates.clear();
+    const int c = label[static_cast<size_t>(v)];
+    if (c >= 0) {
+      for (int f : faces_of[static_cast<size_t>(c)])
+        for (int k = 0; k < 3; ++k)
+          for (int g : faces_of[static_cast<size_t>(sim.F(f, k))])
+            if (!seen[static_cast<size_t>(g)]) seen[static_cast<size_t>(g)] = 1, candidates.push_back(g);
+      for (int g : candidates) seen[static_cast<size_t>(g)] = 0;
+      std::sort(candidates.begin(), candidates.end());  // ties go to the lowest face
+    }
+    if (candidates.empty())
+      for (int g = 0; g < static_cast<int>(sim.F.rows()); ++g) candidates.push_back(g);
+    const Eigen::Vector3d x = skin.V.row(v).transpose();
+    double best = std::numeric_limits<double>::infinity();
+    for (int f : candidates) {
+      const Eigen::Vector3d a = sim.V.row(sim.F(f, 0)), bb = sim.V.row(sim.F(f, 1)), cc = sim.V.row(sim.F(f, 2));
+      const Eigen::Vector3d w = nearest_on_triangle(x, a, bb, cc);
+      const double d = (w[0] * a + w[1] * bb + w[2] * cc - x).squaredNorm();
+      if (d < best) {
+        best = d;
+        b.corner.row(v) = sim.F.row(f);
+        b.weight.row(v) = w.transpose();
+      }
+    }
+  }
+  return b;
+}
+
+SimMesh identity_sim(const Part &skin, int index) {
+  SimMesh sim;
+  sim.skin = index;
+  sim.V = skin.V;
+  sim.F = skin.F;
+  sim.kept.resize(static_cast<size_t>(skin.V.rows()));
+  for (size_t v = 0; v < sim.kept.size(); ++v) sim.kept[v] = static_cast<int>(v);
+  return sim;
+}
+
+}  // namespace
+
+Expected<SimMesh> make_sim_mesh(const Scene &scene, const FdpSet &fdps, const SimMeshOptions &options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const int skin_index = scene.find_kind(PartKind::Skin);
+  if (skin_index < 0) return Status::error(scene.source + ": no skin part (the part holding FDP 2.1)");
+  const Part &skin = scene.parts[static_cast<size_t>(skin_index)];
+  const int n = static_cast<int>(skin.V.rows());
+  auto identity = [&] {
+    SimMesh sim = identity_sim(skin, skin_index);
+    sim.binding = bind_fine_to_coarse(skin, sim);
+    sim.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return sim;
+  };
+  if (options.vertices <= 0 || n * 4 <= options.vertices * 5) return identity();
+
+  TriMesh mesh;
+  std::vector<TriMesh::VertexHandle> vh(static_cast<size_t>(n));
+  for (int v = 0; v < n; ++v) vh[static_cast<size_t>(v)] = mesh.add_vertex(TriMesh::Point(skin.V(v, 0), skin.V(v, 1), skin.V(v, 2)));
+  for (Eigen::Index f = 0; f < skin.F.rows(); ++f) {
+    const TriMesh::FaceHandle fh =
+        mesh.add_face(vh[static_cast<size_t>(skin.F(f, 0))], vh[static_cast<size_t>(skin.F(f, 1))], vh[static_cast<size_t>(skin.F(f, 2))]);
+    // check_skin() refuses non-manifold skins before a model is built; one
+    // that gets here anyway is simulated as it is.
+    if (!fh.is_valid()) return identity();
+  }
+  mesh.request_vertex_status();
+  mesh.request_edge_status();
+  mesh.request_halfedge_status();
+  mesh.request_face_status();
+  mesh.request_face_normals();
+  mesh.update_face_normals();
+
+  // Every skin FDP stays, and sets the finer sizing around eyes and mouth.
+  std::vector<Eigen::Vector3d> features;
+  Eigen::Vector3d eye_l = Eigen::Vector3d::Zero(), eye_r = Eigen::Vector3d::Zero();
+  bool has_l = false, has_r = false;
+  for (const FdpPoint &p : fdps.points) {
+    if (p.id == FdpId{3, 5}) eye_l = p.pos, has_l = true;
+    if (p.id == FdpId{3, 6}) eye_r = p.pos, has_r = true;
+    if (p.part != skin_index || p.vertex < 0 || p.vertex >= n) continue;
+    mesh.status(vh[static_cast<size_t>(p.vertex)]).set_locked(true);
+    if (is_feature(p.id)) features.push_back(p.pos);
+  }
+  // Without both pupils, a tenth of the skin's diagonal stands in for the
+  // eye separation.
+  Eigen::Vector3d lo = skin.V.colwise().minCoeff(), hi = skin.V.colwise().maxCoeff();
+  const double es0 = has_l && has_r ? (eye_l - eye_r).norm() : 0.1 * (hi - lo).norm();
+  const double reach = kFeatureReach * es0;
+
+  using Decimater = OpenMesh::Decimater::DecimaterT<TriMesh>;
+  Decimater dec(mesh);
+  ModSizedLengthT<TriMesh>::Handle length;
+  OpenMesh::Decimater::ModNormalDeviationT<TriMesh>::Handle normal;
+  OpenMesh::Decimater::ModHausdorffT<TriMesh>::Handle distance;
+  OpenMesh::Decimater::ModAspectRatioT<TriMesh>::Handle aspect;
+  dec.add(length);
+  dec.add(normal);
+  dec.add(distance);
+  dec.add(aspect);
+  dec.module(length).sizing = [&features, reach](const Eigen::Vector3d &x) {
+    double d = std::numeric_limits<double>::infinity();
+    for (const Eigen::Vector3d &f : features) d = std::min(d, (x - f).norm());
+    return kFeatureSizing + (1 - kFeatureSizing) * std::min(1.0, d / reach);
+  };
+  dec.module(normal).set_normal_deviation(kMaxNormalTurnDegrees);
+  dec.module(distance).set_tolerance(kMaxDistance * es0);
+  dec.module(aspect).set_aspect_ratio(kMaxAspectRatio);
+  dec.module(aspect).set_binary(true);
+  if (!dec.initialize()) return identity();
+  dec.decimate_to(static_cast<size_t>(options.vertices));
+
+  // The survivors, in skin order, and their triangles (no garbage
+  // collection: a handle's index is still its skin vertex).
+  SimMesh sim;
+  sim.skin = skin_index;
+  sim.decimated = true;
+  std::vector<int> coarse_of(static_cast<size_t>(n), -1);
+  for (int v = 0; v < n; ++v)
+    if (!mesh.status(vh[static_cast<size_t>(v)]).deleted()) {
+      coarse_of[static_cast<size_t>(v)] = static_cast<int>(sim.kept.size());
+      sim.kept.push_back(v);
+    }
+  sim.V.resize(static_cast<Eigen::Index>(sim.kept.size()), 3);
+  for (size_t c = 0; c < sim.kept.size(); ++c) sim.V.row(static_cast<Eigen::Index>(c)) = skin.V.row(sim.kept[c]);
+  std::vector<Eigen::Vector3i> tris;
+  for (TriMesh::FaceHandle fh : mesh.faces()) {
+    if (mesh.status(fh).deleted()) continue;
+    Eigen::Vector3i t;
+    int k = 0;
+    for (TriMesh::VertexHandle v : mesh.fv_range(fh)) t[k++] = coarse_of[static_cast<size_t>(v.idx())];
+    tris.push_back(t);
+  }
+  // A fixed face order whatever the decimater's internal one: by corners.
+  for (Eigen::Vector3i &t : tris) {
+    int m = 0;
+    for (int k = 1; k < 3; ++k) if (t[k] < t[m]) m = k;
+    t = Eigen::Vector3i(t[m], t[(m + 1) % 3], t[(m + 2) % 3]);
+  }
+  std::sort(tris.begin(), tris.end(), [](const Eigen::Vector3i &a, const Eigen::Vector3i &b) {
+    return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
+  });
+  sim.F.resize(static_cast<Eigen::Index>(tris.size()), 3);
+  for (size_t f = 0; f < tris.size(); ++f) sim.F.row(static_cast<Eigen::Index>(f)) = tris[f].transpose();
+  sim.binding = bind_fine_to_coarse(skin, sim);
+  sim.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return sim;
+}
+
+Scene sim_scene(const Scene &scene, const SimMesh &sim) {
+  Scene out = scene;
+  if (!sim.decimated) return out;
+  Part &p = out.parts[static_cast<size_t>(sim.skin)];
+  const Part &s = scene.parts[static_cast<size_t>(sim.skin)];
+  p.V = sim.V;
+  p.F = sim.F;
+  p.TC.resize(0, 2);
+  p.FTC.resize(0, 3);
+  if (s.C.rows() == s.V.rows()) {
+    p.C.resize(sim.V.rows(), 3);
+    for (size_t c = 0; c < sim.kept.size(); ++c) p.C.row(static_cast<Eigen::Index>(c)) = s.C.row(sim.kept[c]);
+  }
+  return out;
+}
+
+FdpSet sim_fdps(const FdpSet &fdps, const SimMesh &sim) {
+  FdpSet out = fdps;
+  if (!sim.decimated) return out;
+  std::vector<int> coarse_of(static_cast<size_t>(sim.binding.corner.rows()), -1);
+  for (size_t c = 0; c < sim.kept.size(); ++c) coarse_of[static_cast<size_t>(sim.kept[c])] = static_cast<int>(c);
+  for (FdpPoint &p : out.points)
+    if (p.part == sim.skin && p.vertex >= 0) p.vertex = coarse_of[static_cast<size_t>(p.vertex)];
+  return out;
+}
+
+FdpSet lift_fdps(const FdpSet &coarse, const SimMesh &sim) {
+  FdpSet out = coarse;
+  if (!sim.decimated) return out;
+  for (FdpPoint &p : out.points)
+    if (p.part == sim.skin && p.vertex >= 0) p.vertex = sim.kept[static_cast<size_t>(p.vertex)];
+  return out;
+}
+
+Expected<SimFaceModel> build_sim_face_model(const Scene &scene, const FdpSet &fdps, SimMeshOptions sim_options,
+                                            const FaceModelOptions &options,
+                                            const std::function<void(const SimMesh &)> &on_mesh) {
+  std::vector<std::string> notes;
+  for (;;) {
+    Expected<SimMesh> sim = make_sim_mesh(scene, fdps, sim_options);
+    if (!sim) return sim.status();
+    if (on_mesh) on_mesh(*sim);
+    Scene coarse = sim_scene(scene, *sim);
+    Expected<FaceModel> model = build_face_model(coarse, sim_fdps(fdps, *sim), options);
+    if (model) return SimFaceModel{std::move(*sim), std::move(coarse), std::move(*model), std::move(notes)};
+    if (!sim->decimated) return model.status();
+    const int skin_vertices = static_cast<int>(sim->binding.corner.rows());
+    const int finer = sim_options.vertices * 3 / 2;
+    sim_options.vertices = finer * 5 < skin_vertices * 4 ? finer : 0;
+    notes.push_back("on the " + std::to_string(sim->kept.size()) + "-vertex simulation mesh: " +
+                    model.status().message() + "; tried " +
+                    (sim_options.vertices ? std::to_string(sim_options.vertices) + " vertices" : "the whole skin"));
+  }
+}
+
+Eigen::MatrixXd lift_displacement(const SimMesh &sim, const Eigen::MatrixXd &Dc) {
+  if (Dc.rows() == 0) return Dc;
+  return carried_displacement(sim.binding, Dc);
+}
+
+}  // namespace afmb

@@ -1,0 +1,105 @@
+// The simulation mesh: a coarser copy of the skin that the anatomy is built
+// and solved on, and the transfer of its motion to every skin vertex.
+//
+// The cost of a build grows with the skin (every pose factorises a tangent
+// of 12 unknowns per dynamic vertex), while what a morph target holds is a
+// smooth field of a few centimetres. A 10k-vertex skin is therefore
+// simulated on about a thousand of its own vertices and the motion carried
+// back, as lashes ride on the skin (skin_binding.h):
+//
+//   SimMesh sim = *make_sim_mesh(scene, fdps, {1000});
+//   Scene coarse = sim_scene(scene, sim);          // the skin replaced
+//   FdpSet coarse_fdps = sim_fdps(fdps, sim);      // skin FDPs re-indexed
+//   ... build the model and its targets on (coarse, coarse_fdps) ...
+//   Eigen::MatrixXd D = lift_displacement(sim, Dc);  // #V x 3 on the skin
+//
+// The coarse skin is made by half-edge collapses (OpenMesh's decimater), so
+// its vertices are skin vertices, at their own positions. Every skin FDP is
+// kept, so an FDP moves exactly as the simulation moves it. Edges are
+// collapsed shortest first, their length measured against a sizing that is
+// half as long around the eyes and the mouth (the lids and lips need the
+// resolution); no collapse may turn a triangle's normal by more than 60
+// degrees or leave a triangle of aspect ratio above 5, and the mesh stays a
+// manifold with the same boundaries (the mouth slit and eye openings).
+//
+// Each skin vertex is bound to the nearest point of the coarse triangles
+// around its nearest kept vertex along the skin's edges, so a vertex of the
+// upper lip never binds across the mouth slit to the lower one. Its
+// displacement is the same barycentric blend of those corners'. A kept
+// vertex binds to itself.
+#pragma once
+
+#include <Eigen/Core>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "anatomy/face_model.h"
+#include "anatomy/skin_binding.h"
+#include "core/fdp.h"
+#include "core/scene.h"
+#include "core/status.h"
+
+namespace afmb {
+
+// afm-build's default simulation mesh size.
+constexpr int kDefaultSimVertices = 1000;
+
+struct SimMeshOptions {
+  // Coarse vertex count to aim at. 0, or a skin of at most 1.25 times as
+  // many vertices: no decimation (the simulation mesh is the skin). The
+  // decimation stops earlier when no legal collapse is left.
+  int vertices = 0;
+};
+
+struct SimMesh {
+  int skin = -1;            // scene part index of the skin
+  bool decimated = false;   // false: V, F are the skin's own, kept is the identity
+  Eigen::MatrixXd V;        // #Vc x 3 coarse vertex positions, model units
+  Eigen::MatrixXi F;        // #Fc x 3 coarse triangles into V, counter-clockwise from outside
+  std::vector<int> kept;    // #Vc: the skin vertex each coarse vertex is
+  SkinBinding binding;      // #V rows: each skin vertex's coarse triangle and weights
+  double seconds = 0;       // time taken
+};
+
+// The simulation mesh of the skin part (the one holding FDP 2.1) of a scene
+// whose FDPs are bound (bind_fdps). Fails when there is no skin part.
+Expected<SimMesh> make_sim_mesh(const Scene &scene, const FdpSet &fdps, const SimMeshOptions &options);
+
+// `scene` with its skin part's geometry replaced by the coarse mesh: V and F
+// from `sim`, per-vertex colours of the kept vertices, no texture
+// coordinates. Other parts are copied unchanged, in the same order.
+Scene sim_scene(const Scene &scene, const SimMesh &sim);
+
+// `fdps` with each point on the skin re-indexed into the coarse mesh (every
+// skin FDP is a kept vertex); other points unchanged.
+FdpSet sim_fdps(const FdpSet &fdps, const SimMesh &sim);
+
+// The inverse: points on the coarse skin re-indexed into the skin.
+FdpSet lift_fdps(const FdpSet &coarse, const SimMesh &sim);
+
+// The skin displacement (#V x 3) carried from a coarse one (#Vc x 3).
+Eigen::MatrixXd lift_displacement(const SimMesh &sim, const Eigen::MatrixXd &Dc);
+
+}  // namespace afmb
+
+namespace afmb {
+
+// The face model built on a simulation mesh, as afm-build makes it.
+struct SimFaceModel {
+  SimMesh sim;
+  Scene scene;       // the input with the simulation mesh as its skin: what `model` is built on
+  FaceModel model;   // its FDPs index the coarse skin (lift_fdps maps them back)
+  std::vector<std::string> notes;  // one per retry: the mesh that failed and why
+};
+
+// make_sim_mesh, then build_face_model on it. A decimated mesh on which the
+// model does not build (a coarse tissue that cannot calibrate an essential
+// muscle) is made again 1.5 times as fine, up to the skin itself, whose
+// failure is returned. `on_mesh`, when given, is called with each
+// simulation mesh before its model is built.
+Expected<SimFaceModel> build_sim_face_model(const Scene &scene, const FdpSet &fdps, SimMeshOptions sim_options,
+                                            const FaceModelOptions &options,
+                                            const std::function<void(const SimMesh &)> &on_mesh = {});
+
+}  // namespace afmb

@@ -1,0 +1,271 @@
+// The simulation mesh (anatomy/sim_mesh.h): a coarser copy of the skin that
+// keeps every FDP, the openings and the surface, and carries its motion back
+// to every skin vertex.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <map>
+#include <memory>
+#include <queue>
+#include <set>
+
+#include "anatomy/sim_mesh.h"
+#include "refhead/refhead.h"
+
+using namespace afmb;
+
+namespace {
+
+const RefHead &head_2k() {
+  static std::unique_ptr<RefHead> h;
+  if (!h) {
+    RefHeadOptions o;
+    o.skin_vertices = 2000;
+    Expected<RefHead> r = make_reference_head(o);
+    EXPECT_TRUE(r.is_ok()) << r.status().message();
+    h = std::make_unique<RefHead>(std::move(*r));
+  }
+  return *h;
+}
+
+const SimMesh &sim_700() {
+  static std::unique_ptr<SimMesh> s;
+  if (!s) {
+    Expected<SimMesh> r = make_sim_mesh(head_2k().scene, head_2k().fdps, SimMeshOptions{700});
+    EXPECT_TRUE(r.is_ok()) << r.status().message();
+    s = std::make_unique<SimMesh>(std::move(*r));
+  }
+  return *s;
+}
+
+// Boundary loops of a triangle mesh (edges used by one triangle), counted.
+int boundary_loops(const Eigen::MatrixXi &F, int *nonmanifold_edges) {
+  std::map<std::pair<int, int>, int> uses;
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = F(f, k), b = F(f, (k + 1) % 3);
+      uses[{std::min(a, b), std::max(a, b)}]++;
+    }
+  std::map<int, std::vector<int>> next;
+  *nonmanifold_edges = 0;
+  for (const auto &[e, n] : uses) {
+    if (n > 2) ++*nonmanifold_edges;
+    if (n == 1) next[e.first].push_back(e.second), next[e.second].push_back(e.first);
+  }
+  std::set<int> seen;
+  int loops = 0;
+  for (const auto &[v, _] : next) {
+    if (seen.count(v)) continue;
+    ++loops;
+    std::vector<int> stack{v};
+    while (!stack.empty()) {
+      const int u = stack.back();
+      stack.pop_back();
+      if (!seen.insert(u).second) continue;
+      for (int w : next[u]) stack.push_back(w);
+    }
+  }
+  return loops;
+}
+
+// Vertex normals of a mesh (area-weighted), #V x 3.
+Eigen::MatrixXd vertex_normals(const Eigen::MatrixXd &V, const Eigen::MatrixXi &F) {
+  Eigen::MatrixXd N = Eigen::MatrixXd::Zero(V.rows(), 3);
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
+    const Eigen::Vector3d n = (b - a).cross(c - a);
+    for (int k = 0; k < 3; ++k) N.row(F(f, k)) += n.transpose();
+  }
+  N.rowwise().normalize();
+  return N;
+}
+
+TEST(SimMesh, KeepsEveryFdpTheOpeningsAndTheSurface) {
+  const RefHead &h = head_2k();
+  const SimMesh &s = sim_700();
+  const Part &skin = h.scene.parts[static_cast<size_t>(s.skin)];
+  ASSERT_TRUE(s.decimated);
+  // The decimation reaches its target (nothing stops it on a clean head).
+  EXPECT_EQ(s.V.rows(), 700);
+  EXPECT_EQ(s.kept.size(), 700u);
+  EXPECT_TRUE(std::is_sorted(s.kept.begin(), s.kept.end()));
+  for (size_t c = 0; c < s.kept.size(); ++c)
+    EXPECT_EQ(s.V.row(static_cast<Eigen::Index>(c)), skin.V.row(s.kept[c])) << "coarse vertex " << c;
+
+  // Every skin FDP is a coarse vertex at the same place, both ways.
+  const FdpSet coarse = sim_fdps(h.fdps, s);
+  const FdpSet back = lift_fdps(coarse, s);
+  int on_skin = 0;
+  for (size_t i = 0; i < h.fdps.points.size(); ++i) {
+    const FdpPoint &p = h.fdps.points[i];
+    if (p.part != s.skin) continue;
+    ++on_skin;
+    const int c = coarse.points[i].vertex;
+    ASSERT_GE(c, 0) << p.id.str();
+    EXPECT_EQ(s.V.row(c).transpose(), p.pos) << p.id.str();
+    EXPECT_EQ(back.points[i].vertex, p.vertex) << p.id.str();
+  }
+  EXPECT_GT(on_skin, 40);
+
+  // A manifold with the skin's openings (mouth slit, two eyes, the neck).
+  int fine_nm = 0, coarse_nm = 0;
+  EXPECT_EQ(boundary_loops(s.F, &coarse_nm), boundary_loops(skin.F, &fine_nm));
+  EXPECT_EQ(coarse_nm, 0);
+  EXPECT_EQ(fine_nm, 0);
+
+  // The surface is the skin's: no coarse triangle is turned over against
+  // the skin's normals at its corners, none is a sliver, and every skin vertex lies
+  // close to it (within a fifth of the coarse mean edge).
+  const Eigen::MatrixXd N = vertex_normals(skin.V, skin.F);
+  double edge = 0;
+  for (Eigen::Index f = 0; f < s.F.rows(); ++f) {
+    const Eigen::Vector3d a = s.V.row(s.F(f, 0)), b = s.V.row(s.F(f, 1)), c = s.V.row(s.F(f, 2));
+    const Eigen::Vector3d n = (b - a).cross(c - a);
+    for (int k = 0; k < 3; ++k)
+      EXPECT_GT(n.normalized().dot(N.row(s.kept[static_cast<size_t>(s.F(f, k))])), 0.0) << "coarse face " << f;
+    const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+    EXPECT_LT(longest * longest / n.norm(), 8.0) << "coarse face " << f << " is a sliver";
+    edge += ((b - a).norm() + (c - b).norm() + (a - c).norm()) / 3;
+  }
+  edge /= static_cast<double>(s.F.rows());
+  double farthest = 0;
+  for (Eigen::Index v = 0; v < skin.V.rows(); ++v) {
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 3; ++k) p += s.binding.weight(v, k) * s.V.row(s.binding.corner(v, k)).transpose();
+    farthest = std::max(farthest, (p - skin.V.row(v).transpose()).norm());
+  }
+  EXPECT_LT(farthest, 0.2 * edge);
+
+  // Finer around the eyes and the mouth: the share of skin vertices kept
+  // within a tenth of an eye separation of an eye corner or a mouth corner
+  // is at least 1.5 times the share kept farther than half an eye separation
+  // from every eye and lip FDP (the skin is already finer there; the sizing
+  // asks for edges half as long again).
+  std::vector<Eigen::Vector3d> corners, features;
+  for (const char *id : {"3.7", "3.8", "3.11", "3.12", "8.3", "8.4"})
+    corners.push_back(h.fdps.find(*FdpId::parse(id))->pos);
+  for (const FdpPoint &p : h.fdps.points)
+    if (p.part == s.skin && (p.id.group == 3 || p.id.group == 8 || (p.id.group == 2 && p.id.index >= 2 && p.id.index <= 9)))
+      features.push_back(p.pos);
+  const double es0 = (h.fdps.find(FdpId{3, 5})->pos - h.fdps.find(FdpId{3, 6})->pos).norm();
+  auto nearest = [](const std::vector<Eigen::Vector3d> &set, const Eigen::Vector3d &x) {
+    double d = std::numeric_limits<double>::infinity();
+    for (const Eigen::Vector3d &c : set) d = std::min(d, (x - c).norm());
+    return d;
+  };
+  std::vector<uint8_t> kept(static_cast<size_t>(skin.V.rows()), 0);
+  for (int v : s.kept) kept[static_cast<size_t>(v)] = 1;
+  double in[2] = {0, 0}, all[2] = {0, 0};
+  for (Eigen::Index v = 0; v < skin.V.rows(); ++v) {
+    const Eigen::Vector3d x = skin.V.row(v).transpose();
+    const int side = nearest(corners, x) < 0.1 * es0 ? 1 : nearest(features, x) > 0.5 * es0 ? 0 : -1;
+    if (side < 0) continue;
+    all[side] += 1;
+    in[side] += kept[static_cast<size_t>(v)];
+  }
+  ASSERT_GT(all[1], 10);
+  EXPECT_GT(in[1] / all[1], 1.5 * in[0] / all[0]) << in[1] << "/" << all[1] << " near, " << in[0] << "/" << all[0];
+}
+
+TEST(SimMesh, CarriesAnAffineFieldWithinItsDistanceToTheCoarseSurface) {
+  const RefHead &h = head_2k();
+  const SimMesh &s = sim_700();
+  const Part &skin = h.scene.parts[static_cast<size_t>(s.skin)];
+  Eigen::Matrix3d A;
+  A << 0.3, -0.1, 0.05, 0.2, 0.1, -0.4, 0.0, 0.25, 0.15;
+  const Eigen::RowVector3d b(0.001, -0.002, 0.003);
+  const Eigen::MatrixXd Dc = (s.V * A.transpose()).rowwise() + b;
+  const Eigen::MatrixXd D = lift_displacement(s, Dc);
+  ASSERT_EQ(D.rows(), skin.V.rows());
+  const double norm_a = A.jacobiSvd().singularValues()(0);
+  std::vector<int> coarse_of(static_cast<size_t>(skin.V.rows()), -1);
+  for (size_t c = 0; c < s.kept.size(); ++c) coarse_of[static_cast<size_t>(s.kept[c])] = static_cast<int>(c);
+  for (Eigen::Index v = 0; v < skin.V.rows(); ++v) {
+    const Eigen::RowVector3d x = skin.V.row(v);
+    const Eigen::RowVector3d exact = x * A.transpose() + b;
+    if (const int c = coarse_of[static_cast<size_t>(v)]; c >= 0) {
+      EXPECT_EQ(D.row(v), Dc.row(c)) << "kept vertex " << v;
+      continue;
+    }
+    // Blending an affine field is exact at the bound point p, so the error
+    // at x is A (x - p): at most |A| |x - p|.
+    Eigen::RowVector3d p = Eigen::RowVector3d::Zero();
+    for (int k = 0; k < 3; ++k) p += s.binding.weight(v, k) * s.V.row(s.binding.corner(v, k));
+    EXPECT_LE((D.row(v) - exact).norm(), norm_a * (x - p).norm() + 1e-12) << "vertex " << v;
+  }
+}
+
+// A skin vertex binds to corners near it along the skin, never across the
+// mouth slit or an eye opening: the path along the skin's edges from the
+// vertex to each corner of its triangle is at most twice that triangle's
+// longest edge. (Across the mouth slit, the path goes round a mouth corner.)
+TEST(SimMesh, BindsEachSkinVertexToCornersNearItAlongTheSkin) {
+  const RefHead &h = head_2k();
+  const SimMesh &s = sim_700();
+  const Part &skin = h.scene.parts[static_cast<size_t>(s.skin)];
+  const int n = static_cast<int>(skin.V.rows());
+  std::vector<std::vector<int>> adj(static_cast<size_t>(n));
+  for (Eigen::Index f = 0; f < skin.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      adj[static_cast<size_t>(skin.F(f, k))].push_back(skin.F(f, (k + 1) % 3));
+      adj[static_cast<size_t>(skin.F(f, (k + 1) % 3))].push_back(skin.F(f, k));
+    }
+  double lip_limit = 0;  // the limit at FDP 2.2's vertex
+  const int lip = h.fdps.find(FdpId{2, 2})->vertex;
+  for (int v = 0; v < n; ++v) {
+    std::set<int> targets;
+    double longest = 0;
+    for (int k = 0; k < 3; ++k) {
+      if (s.binding.weight(v, k) > 0.01) targets.insert(s.kept[static_cast<size_t>(s.binding.corner(v, k))]);
+      longest = std::max(longest, (s.V.row(s.binding.corner(v, k)) - s.V.row(s.binding.corner(v, (k + 1) % 3))).norm());
+    }
+    const double limit = 2 * longest;
+    if (v == lip) lip_limit = limit;
+    // Dijkstra from v, stopped beyond the limit.
+    std::map<int, double> dist{{v, 0.0}};
+    using Item = std::pair<double, int>;
+    std::priority_queue<Item, std::vector<Item>, std::greater<Item>> q;
+    q.emplace(0.0, v);
+    while (!q.empty()) {
+      const auto [d, u] = q.top();
+      q.pop();
+      if (d > dist[u] || d > limit) continue;
+      targets.erase(u);
+      if (targets.empty()) break;
+      for (int w : adj[static_cast<size_t>(u)]) {
+        const double dw = d + (skin.V.row(w) - skin.V.row(u)).norm();
+        auto it = dist.find(w);
+        if (it == dist.end() || dw < it->second) dist[w] = dw, q.emplace(dw, w);
+      }
+    }
+    EXPECT_TRUE(targets.empty()) << "skin vertex " << v << " at " << skin.V.row(v)
+                                 << " binds to a corner farther than " << limit << " along the skin";
+  }
+  // The mouth slit is in the way of a straight binding: the lips' FDPs 2.2
+  // and 2.3 (inner upper and lower lip midpoints) are near in space and far
+  // along the skin.
+  const Eigen::Vector3d up = h.fdps.find(FdpId{2, 2})->pos, low = h.fdps.find(FdpId{2, 3})->pos;
+  EXPECT_LT((up - low).norm(), lip_limit);
+}
+
+TEST(SimMesh, NoDecimationBelowTheSkinsOwnSize) {
+  const RefHead &h = head_2k();
+  Expected<SimMesh> s = make_sim_mesh(h.scene, h.fdps, SimMeshOptions{0});
+  ASSERT_TRUE(s.is_ok());
+  EXPECT_FALSE(s->decimated);
+  const Part &skin = h.scene.parts[static_cast<size_t>(s->skin)];
+  EXPECT_EQ(s->V, skin.V);
+  const Eigen::MatrixXd D = Eigen::MatrixXd::Random(skin.V.rows(), 3);
+  EXPECT_EQ(lift_displacement(*s, D), D);
+  Scene none;
+  none.source = "empty.wrl";
+  Expected<SimMesh> bad = make_sim_mesh(none, h.fdps, SimMeshOptions{500});
+  ASSERT_FALSE(bad.is_ok());
+  EXPECT_NE(bad.status().message().find("empty.wrl"), std::string::npos);
+}
+
+}  // namespace
