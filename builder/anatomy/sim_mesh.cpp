@@ -115,7 +115,9 @@ SkinBinding bind_fine_to_coarse(const Part &skin, const SimMesh &sim) {
     for (int k = 0; k < 3; ++k) faces_of[static_cast<size_t>(sim.F(f, k))].push_back(static_cast<int>(f));
   std::vector<int> coarse_of(static_cast<size_t>(n), -1);
   for (int c = 0; c < nc; ++c) coarse_of[static_cast<size_t>(sim.kept[static_cast<size_t>(c)])] = c;
-  const std::vector<int> label = nearest_kept(skin, sim.kept);
+  // Every vertex is kept when the mesh is the skin: nothing to search.
+  const std::vector<int> label =
+      sim.decimated ? nearest_kept(skin, sim.kept) : std::vector<int>(static_cast<size_t>(n), -1);
 
   SkinBinding b;
   b.part = sim.skin;
@@ -149,9 +151,8 @@ SkinBinding bind_fine_to_coarse(const Part &skin, const SimMesh &sim) {
     const Eigen::Vector3d x = skin.V.row(v).transpose();
     double best = std::numeric_limits<double>::infinity();
     for (int f : candidates) {
-      const Eigen::Vector3d a = sim.V.row(sim.F(f, 0)), bb = sim.V.row(sim.F(f, 1)), cc = sim.V.row(sim.F(f, 2));
-      const Eigen::Vector3d w = nearest_on_triangle(x, a, bb, cc);
-      const double d = (w[0] * a + w[1] * bb + w[2] * cc - x).squaredNorm();
+      Eigen::Vector3d w;
+      const double d = nearest_on_face(x, sim.V, sim.F, f, &w);
       if (d < best) {
         best = d;
         b.corner.row(v) = sim.F.row(f);
@@ -190,10 +191,11 @@ Expected<SimMesh> make_sim_mesh(const Scene &scene, const FdpSet &fdps, const Si
 
   TriMesh mesh;
   std::vector<TriMesh::VertexHandle> vh(static_cast<size_t>(n));
-  for (int v = 0; v < n; ++v) vh[static_cast<size_t>(v)] = mesh.add_vertex(TriMesh::Point(skin.V(v, 0), skin.V(v, 1), skin.V(v, 2)));
+  for (int v = 0; v < n; ++v)
+    vh[static_cast<size_t>(v)] = mesh.add_vertex(TriMesh::Point(skin.V(v, 0), skin.V(v, 1), skin.V(v, 2)));
+  auto corner = [&](Eigen::Index f, int k) { return vh[static_cast<size_t>(skin.F(f, k))]; };
   for (Eigen::Index f = 0; f < skin.F.rows(); ++f) {
-    const TriMesh::FaceHandle fh =
-        mesh.add_face(vh[static_cast<size_t>(skin.F(f, 0))], vh[static_cast<size_t>(skin.F(f, 1))], vh[static_cast<size_t>(skin.F(f, 2))]);
+    const TriMesh::FaceHandle fh = mesh.add_face(corner(f, 0), corner(f, 1), corner(f, 2));
     // check_skin() refuses non-manifold skins before a model is built; one
     // that gets here anyway is simulated as it is.
     if (!fh.is_valid()) return identity();

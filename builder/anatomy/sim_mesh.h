@@ -19,8 +19,10 @@
 // collapsed shortest first, their length measured against a sizing that is
 // half as long around the eyes and the mouth (the lids and lips need the
 // resolution); no collapse may turn a triangle's normal by more than 60
-// degrees or leave a triangle of aspect ratio above 5, and the mesh stays a
-// manifold with the same boundaries (the mouth slit and eye openings).
+// degrees from the skin normals it covers, leave a skin vertex more than
+// 0.03 eye separations from the coarse surface, or leave a triangle of
+// aspect ratio above 5, and the mesh stays a manifold with the same
+// boundaries (the mouth slit and eye openings).
 //
 // Each skin vertex is bound to the nearest point of the coarse triangles
 // around its nearest kept vertex along the skin's edges, so a vertex of the
@@ -80,10 +82,6 @@ FdpSet lift_fdps(const FdpSet &coarse, const SimMesh &sim);
 
 // The skin displacement (#V x 3) carried from a coarse one (#Vc x 3).
 Eigen::MatrixXd lift_displacement(const SimMesh &sim, const Eigen::MatrixXd &Dc);
-
-}  // namespace afmb
-
-namespace afmb {
 
 // The face model built on a simulation mesh, as afm-build makes it.
 struct SimFaceModel {

@@ -38,6 +38,13 @@ Eigen::Vector3d nearest_on_triangle(const Eigen::Vector3d &p, const Eigen::Vecto
   return w[best];
 }
 
+double nearest_on_face(const Eigen::Vector3d &p, const Eigen::MatrixXd &V, const Eigen::MatrixXi &F, Eigen::Index f,
+                       Eigen::Vector3d *weight) {
+  const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
+  *weight = nearest_on_triangle(p, a, b, c);
+  return ((*weight)[0] * a + (*weight)[1] * b + (*weight)[2] * c - p).squaredNorm();
+}
+
 std::vector<SkinBinding> bind_to_skin(const Scene &scene, int skin, PartKind kind) {
   std::vector<SkinBinding> out;
   if (skin < 0 || skin >= static_cast<int>(scene.parts.size())) return out;
@@ -62,8 +69,8 @@ std::vector<SkinBinding> bind_to_skin(const Scene &scene, int skin, PartKind kin
         const double r = std::sqrt(std::max({(a - mid).squaredNorm(), (bb - mid).squaredNorm(), (c - mid).squaredNorm()}));
         const double far = (x - mid).norm() - r;
         if (far > 0 && far * far >= best) continue;
-        const Eigen::Vector3d w = nearest_on_triangle(x, a, bb, c);
-        const double d = (w[0] * a + w[1] * bb + w[2] * c - x).squaredNorm();
+        Eigen::Vector3d w;
+        const double d = nearest_on_face(x, s.V, s.F, f, &w);
         if (d < best) {
           best = d;
           b.corner.row(v) = s.F.row(f);

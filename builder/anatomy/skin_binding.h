@@ -28,6 +28,11 @@ struct SkinBinding {
 Eigen::Vector3d nearest_on_triangle(const Eigen::Vector3d &p, const Eigen::Vector3d &a, const Eigen::Vector3d &b,
                                     const Eigen::Vector3d &c);
 
+// The nearest point to p of triangle f of (V, F): its squared distance,
+// and the barycentric weights in *weight.
+double nearest_on_face(const Eigen::Vector3d &p, const Eigen::MatrixXd &V, const Eigen::MatrixXi &F, Eigen::Index f,
+                       Eigen::Vector3d *weight);
+
 // Bindings of every part of `kind` in the scene to part `skin` (its
 // triangles; nothing when it has none). In part order.
 std::vector<SkinBinding> bind_to_skin(const Scene &scene, int skin, PartKind kind);

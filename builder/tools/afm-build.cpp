@@ -374,7 +374,8 @@ int main(int argc, char **argv) {
     if (!report_dir.empty()) {
       FidelityReportOptions ro;
       if (!quiet) ro.progress = progress_line;
-      if (Status st = write_fidelity_report(report_dir, face->scene, lift_fdps(model->fdps, *sim), model->skin, *syn, ro); !st) return fail(st);
+      const FdpSet fdps = lift_fdps(model->fdps, *sim);  // the model's FDPs on the input's skin
+      if (Status st = write_fidelity_report(report_dir, face->scene, fdps, model->skin, *syn, ro); !st) return fail(st);
       std::printf("wrote the fidelity report into %s/ (index.html, sheet.png, report.txt, report.csv)\n",
                   report_dir.c_str());
     }
