@@ -18,7 +18,9 @@
 // kept, so an FDP moves exactly as the simulation moves it. Edges are
 // collapsed shortest first, their length measured against a sizing that is
 // half as long around the eyes and the mouth (the lids and lips need the
-// resolution); no collapse may turn a triangle's normal by more than 60
+// resolution). The lips keep every skin vertex within 0.2 eye separations
+// of a lip FDP (at most half the budget, nearest first): a decimated mouth
+// locks the sphincter of a detailed one (Song's). No collapse may turn a triangle's normal by more than 60
 // degrees from the skin normals it covers, leave a skin vertex more than
 // 0.03 eye separations from the coarse surface, or leave a triangle of
 // aspect ratio above 5, and the mesh stays a manifold with the same

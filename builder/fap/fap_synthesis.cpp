@@ -23,6 +23,14 @@ namespace {
 // Newton iterations allowed to a solve beyond the calibrated range: where
 // the tissue locks it would take hundreds (Song's lower eyelids).
 constexpr int kBeyondIterations = 40;
+// Bisection steps on the share of a viseme's or expression's pose that
+// keeps the skin a face: to a sixteenth.
+constexpr int kShareSteps = 4;
+// A pose folds the skin when it turns over more than one in this many skin
+// triangles. A few turn at any share on Song (slivers in the lid creases,
+// 2-6 of 1,936 on the 1,000-vertex mesh); where the muscles tear the face
+// they turn by hundreds (165 of 4,394 for fear on 2,250).
+constexpr int kFoldShare = 200;
 
 bool is_jaw(FapDriver d) { return d == FapDriver::JawOpen || d == FapDriver::JawThrust || d == FapDriver::JawShift; }
 
@@ -150,22 +158,64 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         const double unit = fapu_distance(model.fapu, info->unit) / 1024.0;
         a.jaw_open = jaw_percent(model.jaw, FapDriver::JawOpen, skin.X0.row(chin->vertex).transpose(),
                                  fap_direction(info), h.jaw_open * unit);
-        jaw = jaw_motion(model.jaw, a.jaw_open, 0, 0);
       }
     }
     if (a.muscles.empty() && a.jaw_open == 0) {
       o.message = "nothing to pose: " + o.message;
     } else {
       FactorCache cache;
-      Expected<Pose> pose = solve_pose(model, a, &cache);
+      auto solve_share = [&](double share) {
+        Activation b = a;
+        for (auto &m : b.muscles) m.second *= share;
+        b.jaw_open *= share;
+        return solve_pose(model, b, &cache);
+      };
+      // The table's pose. Where its muscles together fold the skin or sink
+      // it into the skull (Song's fear and surprise tore the forehead
+      // open), the largest share of it that does not, by bisection.
+      auto torn = [&](const Pose &p) {
+        const SkinFaults f = skin_faults(model, pose_epidermis(model, p));
+        return f.sunk > 0 || f.flipped * kFoldShare > skin.F.rows();
+      };
+      double share = 1;
+      Expected<Pose> pose = solve_share(1);
+      if (pose && torn(*pose)) {
+        const SkinFaults faults = skin_faults(model, pose_epidermis(model, *pose));
+        double lo = 0, hi = 1;
+        std::optional<Pose> kept;
+        for (int step = 0; step < kShareSteps; ++step) {
+          const double mid = 0.5 * (lo + hi);
+          Expected<Pose> p = solve_share(mid);
+          if (p && !torn(*p)) {
+            lo = mid;
+            kept = std::move(*p);
+          } else {
+            hi = mid;
+          }
+        }
+        const std::string what = "the table's pose turns " + std::to_string(faults.flipped) +
+                                 " skin triangles over and sinks " + std::to_string(faults.sunk) +
+                                 " vertices into the skull";
+        if (kept) {
+          pose = std::move(*kept);
+          share = lo;
+          o.message += std::string(o.message.empty() ? "" : "; ") + what + ": made at " +
+                       std::to_string(static_cast<int>(std::lround(100 * share))) + " % of it";
+        } else {
+          pose = Status::error(what + ", and so does " +
+                               std::to_string(static_cast<int>(std::lround(100 * std::ldexp(1.0, -kShareSteps)))) +
+                               " % of it");
+        }
+      }
       if (!pose) {
         o.message = pose.status().message();
       } else {
         const Eigen::MatrixXd D = pose_epidermis(model, *pose) - skin.X0.topRows(skin.n);
+        if (a.jaw_open != 0) jaw = jaw_motion(model.jaw, share * a.jaw_open, 0, 0);
         o.made = true;
         o.largest = D.rowwise().norm().maxCoeff();
         o.dynamic = static_cast<int>(pose->dynamic.size());
-        o.scale = 1;
+        o.scale = share;
         MorphTarget t;
         t.kind = o.kind;
         t.number = h.number;
