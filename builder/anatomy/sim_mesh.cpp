@@ -21,6 +21,9 @@
 #include <string>
 #include <utility>
 
+#include "anatomy/fdp_completion.h"
+#include "core/part_kind.h"
+
 namespace afmb {
 
 namespace {
@@ -343,13 +346,27 @@ Expected<SimFaceModel> build_sim_face_model(const Scene &scene, const FdpSet &fd
                                             const FaceModelOptions &options,
                                             const std::function<void(const SimMesh &)> &on_mesh) {
   std::vector<std::string> notes;
+  // Missing FDPs are estimated on the skin itself, before the decimation,
+  // which then keeps them: snapped to a coarse mesh, two estimates can
+  // land on one vertex (Song's 9.6 and 9.7 did in a trial).
+  FdpSet complete = fdps;
+  std::vector<std::string> estimates;
+  if (options.estimate_missing_fdps) {
+    if (const int skin = scene.find_kind(PartKind::Skin); skin >= 0) {
+      Expected<std::vector<FdpId>> added = complete_fdps(scene, skin, complete, anatomy_fdps(), &estimates);
+      if (!added) return added.status();
+    }
+  }
   for (;;) {
-    Expected<SimMesh> sim = make_sim_mesh(scene, fdps, sim_options);
+    Expected<SimMesh> sim = make_sim_mesh(scene, complete, sim_options);
     if (!sim) return sim.status();
     if (on_mesh) on_mesh(*sim);
     Scene coarse = sim_scene(scene, *sim);
-    Expected<FaceModel> model = build_face_model(coarse, sim_fdps(fdps, *sim), options);
-    if (model) return SimFaceModel{std::move(*sim), std::move(coarse), std::move(*model), std::move(notes)};
+    Expected<FaceModel> model = build_face_model(coarse, sim_fdps(complete, *sim), options);
+    if (model) {
+      model->notes.insert(model->notes.begin(), estimates.begin(), estimates.end());
+      return SimFaceModel{std::move(*sim), std::move(coarse), std::move(*model), std::move(notes)};
+    }
     if (!sim->decimated) return model.status();
     const int skin_vertices = static_cast<int>(sim->binding.corner.rows());
     const int finer = sim_options.vertices * 3 / 2;

@@ -89,14 +89,16 @@ Eigen::MatrixXd lift_displacement(const SimMesh &sim, const Eigen::MatrixXd &Dc)
 struct SimFaceModel {
   SimMesh sim;
   Scene scene;       // the input with the simulation mesh as its skin: what `model` is built on
-  FaceModel model;   // its FDPs index the coarse skin (lift_fdps maps them back)
+  FaceModel model;   // its FDPs index the coarse skin (lift_fdps maps them back); its
+                     // notes begin with the FDP estimates, made on the skin itself
   std::vector<std::string> notes;  // one per retry: the mesh that failed and why
 };
 
-// make_sim_mesh, then build_face_model on it. A decimated mesh on which the
-// model does not build (a coarse tissue that cannot calibrate an essential
-// muscle) is made again 1.5 times as fine, up to the skin itself, whose
-// failure is returned. `on_mesh`, when given, is called with each
+// The missing FDPs estimated on the skin (when options.estimate_missing_fdps;
+// the decimation keeps them), make_sim_mesh, then build_face_model on it. A
+// decimated mesh on which the model does not build (a coarse tissue that
+// cannot calibrate an essential muscle) is made again 1.5 times as fine, up
+// to the skin itself, whose failure is returned. `on_mesh`, when given, is called with each
 // simulation mesh before its model is built.
 Expected<SimFaceModel> build_sim_face_model(const Scene &scene, const FdpSet &fdps, SimMeshOptions sim_options,
                                             const FaceModelOptions &options,
