@@ -173,14 +173,15 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       // The table's pose. Where its muscles together fold the skin or sink
       // it into the skull (Song's fear and surprise tore the forehead
       // open), the largest share of it that does not, by bisection.
-      auto torn = [&](const Pose &p) {
+      auto torn = [&](const Pose &p, SkinFaults *faults = nullptr) {
         const SkinFaults f = skin_faults(model, pose_epidermis(model, p));
+        if (faults) *faults = f;
         return f.sunk > 0 || f.flipped * kFoldShare > skin.F.rows();
       };
       double share = 1;
       Expected<Pose> pose = solve_share(1);
-      if (pose && torn(*pose)) {
-        const SkinFaults faults = skin_faults(model, pose_epidermis(model, *pose));
+      SkinFaults faults;
+      if (pose && torn(*pose, &faults)) {
         double lo = 0, hi = 1;
         std::optional<Pose> kept;
         for (int step = 0; step < kShareSteps; ++step) {

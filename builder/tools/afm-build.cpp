@@ -309,8 +309,7 @@ int main(int argc, char **argv) {
   }
   std::printf("solver: %s, tolerance %.3g (half the AFM quantum %.3g), wave threshold %.3g\n",
               solver_name(model->solver.kind), model->solver.tolerance, model->quantum, model->wave_threshold);
-  for (const std::string &n : model->notes)
-    std::printf("note: %s\n", n.c_str());
+  for (const std::string &n : model->notes) std::printf("note: %s\n", n.c_str());
   for (const std::string &w : model->warnings) std::printf("warning: %s\n", w.c_str());
   std::printf("%-26s %9s %8s %8s %11s %11s\n", "muscle", "length", "area", "V_d", "tension+", "tension-");
   for (const Muscle &m : model->muscles)

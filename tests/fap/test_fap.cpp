@@ -654,8 +654,8 @@ TEST(FapSynthesis, TargetsMadeOnACoarserSimulationMeshMatchTheSkins) {
 }
 
 // Song's surprise on a 2,250-vertex simulation mesh: the table's brows up,
-// lids wide and jaw down together turn about 200 of its 4,394 skin
-// triangles over. The target is made at the largest share of the pose that
+// lids wide and jaw down together turn hundreds of its skin triangles over
+// (200 of 4,394 when measured). The target is made at the largest share of the pose that
 // keeps the skin a face, and says so.
 TEST(HighLevel, AnExpressionThatTearsTheSkinIsMadeAtTheShareThatDoesNot) {
   AFM_REQUIRE_SHARED_DATA();
