@@ -1,6 +1,7 @@
 #include "anatomy/face_model.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <mutex>
 
@@ -154,8 +155,10 @@ Expected<std::vector<int>> wave_estimate(const FaceModel &model, const Muscle &m
 // 3.3): one equilibrium solve with the tension as an unknown (solver.h, load
 // control), on `set`, grown while the wave reaches its border.
 // *locked: it failed because the tissue locked before the key node got there.
+// *torn (when given): it failed because the pose that gets there tears the
+// skin (SkinFaults::tears).
 Status calibrate_side(const FaceModel &model, Muscle &m, bool maximum, FactorCache *cache, std::vector<int> &set,
-                      bool *locked) {
+                      bool *locked, bool *torn) {
   LoadControl control;
   control.unit_load = unit_load(model, m, maximum ? 1.0 : -1.0);
   control.action = [&](const Eigen::MatrixXd &X, Eigen::MatrixXd *g) { return muscle_action(model.tissue, m, X, g); };
@@ -170,6 +173,11 @@ Status calibrate_side(const FaceModel &model, Muscle &m, bool maximum, FactorCac
     return s.wrap("calibrating " + m.name + ": the " + (maximum ? "maximum" : "minimum") +
                   " contraction (moving its key node " + std::to_string(std::abs(control.value)) +
                   " model units) was not found");
+  if (torn && skin_faults(model, X.topRows(model.tissue.n)).tears()) {
+    *torn = true;
+    return Status::error("calibrating " + m.name + ": the " + (maximum ? "maximum" : "minimum") +
+                         " contraction tears the skin");
+  }
   (maximum ? m.tension_max : m.tension_min) = control.tension;
   return Status::ok();
 }
@@ -248,6 +256,9 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
       todo.push_back(i);
   const size_t tasks = todo.size() + (options.calibrate_jaw ? 1 : 0);
   std::vector<Status> result(tasks);
+  // Per muscle and side (-, +): 1 when a pose tore the skin in its
+  // calibration, 2 when it still does at the range kept.
+  std::vector<std::array<int, 2>> tore(model.muscles.size(), {0, 0});
   Expected<Pose> jaw_pose = Status::error("jaw: not solved");
   model.jaw.dynamic = model.jaw.vertices;
   std::mutex lock;
@@ -262,15 +273,26 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
       Expected<std::vector<int>> set = wave_estimate(model, m);
       Status s = set ? Status::ok() : set.status().wrap("calibrating " + m.name);
       // A muscle whose tissue locks before its key node reaches the
-      // table's range calibrates to a half, a quarter or an eighth of it instead
-      // (not an essential one: its range is what the FAPs rely on).
+      // table's range, or whose pose there tears the skin, calibrates to a
+      // half, a quarter or an eighth of it instead (not an essential one:
+      // its range is what the FAPs rely on).
+      const bool essential = table[static_cast<size_t>(m.def)].essential;
       auto side = [&](bool maximum) {
-        bool locked = false;
-        Status st = calibrate_side(model, m, maximum, &cache, *set, &locked);
+        bool locked = false, torn = false;
+        int &tears = tore[todo[k]][maximum ? 1 : 0];
+        Status st = calibrate_side(model, m, maximum, &cache, *set, &locked, essential ? nullptr : &torn);
         double &range = maximum ? m.range_max : m.range_min;
-        while (locked && range > 0.125 && !table[static_cast<size_t>(m.def)].essential) {
+        while ((locked || torn) && range > 0.125 && !essential) {
+          tears = tears || torn;
           range /= 2;
-          st = calibrate_side(model, m, maximum, &cache, *set, &locked);
+          locked = torn = false;
+          st = calibrate_side(model, m, maximum, &cache, *set, &locked, &torn);
+        }
+        // Torn even at an eighth: kept there, so that the FAPs and
+        // expressions have the muscle; their own checks bound its share.
+        if (torn) {
+          tears = 2;
+          st = calibrate_side(model, m, maximum, &cache, *set, &locked, nullptr);
         }
         return st;
       };
@@ -307,9 +329,12 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
       if (range == 1) continue;
       const std::string side = maximum ? "+100" : "-100";
       const char *part = range == 0.5 ? "a half" : range == 0.25 ? "a quarter" : "an eighth";
-      model.warnings.push_back(m.name + ": its tissue locks before the key node reaches the table's " + side + " % (" +
+      const int tears = tore[i][maximum ? 1 : 0];
+      model.warnings.push_back(m.name + ": " + (tears ? "the skin tears" : "its tissue locks") +
+                               " before the key node reaches the table's " + side + " % (" +
                                std::to_string(std::abs(muscle_action_target(m, maximum)) / range) +
-                               " model units): " + side + " % stands for " + part + " of it");
+                               " model units): " + side + " % stands for " + part + " of it" +
+                               (tears == 2 ? ", where it still tears the skin" : ""));
     }
     kept.push_back(std::move(model.muscles[i]));
   }
@@ -420,20 +445,32 @@ SkinFaults skin_faults(const FaceModel &model, const Eigen::MatrixXd &E) {
     const Eigen::Vector3d a = X.row(s.F(f, 0)), b = X.row(s.F(f, 1)), c = X.row(s.F(f, 2));
     return Eigen::Vector3d((b - a).cross(c - a));
   };
-  double mean = 0;
-  for (Eigen::Index f = 0; f < s.F.rows(); ++f) mean += normal(s.X0, f).norm();
-  mean /= std::max<double>(1, static_cast<double>(s.F.rows()));
+  double total = 0;
+  for (Eigen::Index f = 0; f < s.F.rows(); ++f) total += normal(s.X0, f).norm();
+  const double mean = total / std::max<double>(1, static_cast<double>(s.F.rows()));
+  double turned = 0, stretched = 0;
   for (Eigen::Index f = 0; f < s.F.rows(); ++f) {
-    const Eigen::Vector3d n0 = normal(s.X0, f);
-    if (n0.norm() > 1e-3 * mean && n0.dot(normal(E, f)) <= 0) ++out.flipped;
+    const Eigen::Vector3d n0 = normal(s.X0, f), n = normal(E, f);
+    if (n0.norm() > 1e-3 * mean && n0.dot(n) <= 0) {
+      out.turned_faces.push_back(static_cast<int>(f));
+      turned += n0.norm();
+    }
+    if (n.norm() > kTearStretch * n0.norm()) {
+      out.stretched_faces.push_back(static_cast<int>(f));
+      stretched += n0.norm();
+    }
   }
+  out.turned_share = total > 0 ? turned / total : 0;
+  out.stretched_share = total > 0 ? stretched / total : 0;
   std::vector<char> on_jaw(static_cast<size_t>(s.n), 0);
   for (int v : model.jaw.vertices) on_jaw[static_cast<size_t>(v)] = 1;
   for (int v = 0; v < s.n; ++v) {
     if (on_jaw[static_cast<size_t>(v)] || !s.in_mesh[static_cast<size_t>(v)] || !skull_rejects(s, v)) continue;
     const Eigen::Vector3d skull = s.X0.row(s.node(kSkull, v));
-    if ((E.row(v).transpose() - skull).dot(s.normal.row(v).transpose()) < 0) ++out.sunk;
+    if ((E.row(v).transpose() - skull).dot(s.normal.row(v).transpose()) < -model.quantum) out.sunk_vertices.push_back(v);
   }
+  out.flipped = static_cast<int>(out.turned_faces.size());
+  out.sunk = static_cast<int>(out.sunk_vertices.size());
   return out;
 }
 

@@ -143,13 +143,30 @@ Eigen::MatrixXd pose_epidermis(const FaceModel &model, const Pose &pose);
 
 // What is wrong with an epidermis E (#V x 3, model units) as a face: skin
 // triangles whose normal turned against its rest one (slivers under a
-// thousandth of the mean area left out), and vertices tied to the skull
-// that went below their skull node's rest plane (the jaw's vertices left
-// out: the jaw moves their bone).
+// thousandth of the mean area left out); vertices tied to the skull that
+// went more than one AFM quantum below their skull node's rest plane (the
+// jaw's vertices left out: the jaw moves their bone; within a quantum, the
+// stored target cannot tell them from resting on the bone); and triangles
+// stretched to more than kTearStretch times their rest area, which skin does
+// not survive (Song's left upper lid pulled off the eyeball by the brows).
+// `any` is the strict test of a FAP target. `tears` weighs the shares, for
+// visemes, expressions and the muscles' calibration: a fold turns a few
+// triangles over (slivers at Song's mouth corners, 6e-6 of the skin's area,
+// in every smile; the crease at its left eye's outer corner in joy, 2.7e-4,
+// where the eyeball shows through), a tear far more (surprise pulled Song's
+// left upper lid off the eyeball: 3.4e-3 stretched, 5.7e-3 turned).
+constexpr double kTearStretch = 3;
+constexpr double kTornShare = 1e-4;
 struct SkinFaults {
-  int flipped = 0;
-  int sunk = 0;
+  int flipped = 0;                    // turned_faces.size()
+  int sunk = 0;                       // sunk_vertices.size()
+  std::vector<int> turned_faces;      // skin triangles, ascending
+  std::vector<int> stretched_faces;   // skin triangles, ascending
+  std::vector<int> sunk_vertices;     // skin vertices, ascending
+  double turned_share = 0;            // rest area of turned_faces over the skin's, 0..1
+  double stretched_share = 0;         // rest area of stretched_faces over the skin's, 0..1
   bool any() const { return flipped > 0 || sunk > 0; }
+  bool tears() const { return sunk > 0 || turned_share > kTornShare || stretched_share > kTornShare; }
 };
 SkinFaults skin_faults(const FaceModel &model, const Eigen::MatrixXd &E);
 

@@ -26,11 +26,80 @@ constexpr int kBeyondIterations = 40;
 // Bisection steps on the share of a viseme's or expression's pose that
 // keeps the skin a face: to a sixteenth.
 constexpr int kShareSteps = 4;
-// A pose folds the skin when it turns over more than one in this many skin
-// triangles. A few turn at any share on Song (slivers in the lid creases,
-// 2-6 of 1,936 on the 1,000-vertex mesh); where the muscles tear the face
-// they turn by hundreds (165 of 4,394 for fear on 2,250).
-constexpr int kFoldShare = 200;
+// The other side's muscle of a "..._left" or "..._right" one, else "".
+std::string other_side(const std::string &name) {
+  for (const auto &[from, to] : {std::pair<const char *, const char *>{"_left", "_right"}, {"_right", "_left"}}) {
+    const size_t n = std::char_traits<char>::length(from);
+    if (name.size() > n && name.compare(name.size() - n, n, from) == 0) return name.substr(0, name.size() - n) + to;
+  }
+  return std::string();
+}
+
+// The muscles of activation `a` to blame for `faults` (one flag per
+// a.muscles entry, then one for the jaw): those whose influence area holds a
+// sunk vertex or a corner of the largest turned or stretched triangles, as
+// many as leave the rest of each under kTornShare (the slivers a smile turns
+// at the mouth corners blame nothing), with their other side's twin, so
+// that a reduced expression stays symmetric.
+std::vector<char> blame(const FaceModel &model, const Activation &a, const SkinFaults &faults) {
+  const SkinModel &skin = model.tissue;
+  auto area = [&skin](int f) {
+    const Eigen::Vector3d p = skin.X0.row(skin.F(f, 0)), q = skin.X0.row(skin.F(f, 1)), r = skin.X0.row(skin.F(f, 2));
+    return (q - p).cross(r - p).norm();
+  };
+  double total = 0;
+  for (Eigen::Index f = 0; f < skin.F.rows(); ++f) total += area(static_cast<int>(f));
+  std::vector<char> hit(static_cast<size_t>(skin.n), 0);
+  for (const std::vector<int> *faces : {&faults.turned_faces, &faults.stretched_faces}) {
+    std::vector<int> order = *faces;
+    std::stable_sort(order.begin(), order.end(), [&area](int f, int g) { return area(f) > area(g); });
+    double rest = 0;  // twice the area left unblamed
+    for (int f : order) rest += area(f);
+    for (int f : order) {
+      if (rest <= kTornShare * total) break;
+      for (int k = 0; k < 3; ++k) hit[static_cast<size_t>(skin.F(f, k))] = 1;
+      rest -= area(f);
+    }
+  }
+  for (int v : faults.sunk_vertices) hit[static_cast<size_t>(v)] = 1;
+  std::vector<char> out(a.muscles.size() + 1, 0);
+  auto any_hit = [&hit](const std::vector<int> &vertices) {
+    for (int v : vertices)
+      if (hit[static_cast<size_t>(v)]) return true;
+    return false;
+  };
+  for (size_t k = 0; k < a.muscles.size(); ++k)
+    out[k] = any_hit(model.muscles[static_cast<size_t>(a.muscles[k].first)].influence);
+  out.back() = a.jaw_open != 0 && any_hit(model.jaw.vertices);
+  const std::vector<char> direct = out;
+  for (size_t k = 0; k < a.muscles.size(); ++k) {
+    if (!direct[k]) continue;
+    const std::string other = other_side(model.muscles[static_cast<size_t>(a.muscles[k].first)].name);
+    for (size_t j = 0; j < a.muscles.size(); ++j)
+      if (model.muscles[static_cast<size_t>(a.muscles[j].first)].name == other) out[j] = 1;
+  }
+  return out;
+}
+
+// The muscles `reduced` marks, for a message: "orbicularis_oculi" for both
+// sides of one, "jaw" for the jaw.
+std::string muscle_list(const FaceModel &model, const Activation &a, const std::vector<char> &reduced) {
+  std::vector<std::string> names;
+  for (size_t k = 0; k < a.muscles.size(); ++k) {
+    if (!reduced[k]) continue;
+    std::string n = model.muscles[static_cast<size_t>(a.muscles[k].first)].name;
+    const std::string other = other_side(n);
+    bool both = false;
+    for (size_t j = 0; j < a.muscles.size() && !other.empty(); ++j)
+      both |= reduced[j] && model.muscles[static_cast<size_t>(a.muscles[j].first)].name == other;
+    if (both) n.erase(n.rfind('_'));
+    if (std::find(names.begin(), names.end(), n) == names.end()) names.push_back(n);
+  }
+  if (reduced.back()) names.push_back("jaw");
+  std::string out;
+  for (const std::string &n : names) out += (out.empty() ? "" : ", ") + n;
+  return out;
+}
 
 bool is_jaw(FapDriver d) { return d == FapDriver::JawOpen || d == FapDriver::JawThrust || d == FapDriver::JawShift; }
 
@@ -164,46 +233,67 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       o.message = "nothing to pose: " + o.message;
     } else {
       FactorCache cache;
-      auto solve_share = [&](double share) {
+      // `reduced` marks the muscles (one per a.muscles entry, then the jaw)
+      // that `share` scales; the others keep the table's contraction.
+      auto solve_share = [&](const std::vector<char> &reduced, double share) {
         Activation b = a;
-        for (auto &m : b.muscles) m.second *= share;
-        b.jaw_open *= share;
+        for (size_t k = 0; k < b.muscles.size(); ++k)
+          if (reduced[k]) b.muscles[k].second *= share;
+        if (reduced.back()) b.jaw_open *= share;
         return solve_pose(model, b, &cache);
       };
-      // The table's pose. Where its muscles together fold the skin or sink
-      // it into the skull (Song's fear and surprise tore the forehead
-      // open), the largest share of it that does not, by bisection.
+      // The table's pose. Where it tears the skin (joy turned the crease at
+      // Song's left eye's outer corner over), the largest share of the
+      // muscles to blame that does not, by bisection; of every muscle and
+      // the jaw when that fails.
       auto torn = [&](const Pose &p, SkinFaults *faults = nullptr) {
-        const SkinFaults f = skin_faults(model, pose_epidermis(model, p));
-        if (faults) *faults = f;
-        return f.sunk > 0 || f.flipped * kFoldShare > skin.F.rows();
+        SkinFaults f = skin_faults(model, pose_epidermis(model, p));
+        const bool bad = f.tears();
+        if (faults) *faults = std::move(f);
+        return bad;
       };
+      const std::vector<char> all(a.muscles.size() + 1, 1);
+      std::vector<char> reduced = all;
       double share = 1;
-      Expected<Pose> pose = solve_share(1);
+      Expected<Pose> pose = solve_share(all, 1);
       SkinFaults faults;
       if (pose && torn(*pose, &faults)) {
-        double lo = 0, hi = 1;
-        std::optional<Pose> kept;
-        for (int step = 0; step < kShareSteps; ++step) {
-          const double mid = 0.5 * (lo + hi);
-          Expected<Pose> p = solve_share(mid);
-          if (p && !torn(*p)) {
-            lo = mid;
-            kept = std::move(*p);
-          } else {
-            hi = mid;
+        auto bisect = [&](const std::vector<char> &which) -> std::optional<std::pair<double, Pose>> {
+          double lo = 0, hi = 1;
+          std::optional<Pose> kept;
+          for (int step = 0; step < kShareSteps; ++step) {
+            const double mid = 0.5 * (lo + hi);
+            Expected<Pose> p = solve_share(which, mid);
+            if (p && !torn(*p)) {
+              lo = mid;
+              kept = std::move(*p);
+            } else {
+              hi = mid;
+            }
           }
+          if (!kept) return std::nullopt;
+          return std::make_pair(lo, std::move(*kept));
+        };
+        const std::vector<char> blamed = blame(model, a, faults);
+        std::optional<std::pair<double, Pose>> found;
+        if (blamed != all && std::count(blamed.begin(), blamed.end(), 1) > 0) {
+          found = bisect(blamed);
+          if (found) reduced = blamed;
         }
-        const std::string what = "the table's pose turns " + std::to_string(faults.flipped) +
-                                 " skin triangles over and sinks " + std::to_string(faults.sunk) +
-                                 " vertices into the skull";
-        if (kept) {
-          pose = std::move(*kept);
-          share = lo;
-          o.message += std::string(o.message.empty() ? "" : "; ") + what + ": made at " +
+        if (!found) found = bisect(all);
+        char what[256];
+        std::snprintf(what, sizeof what,
+                      "the table's pose turns %.2g %% of the skin's area over, stretches %.2g %% beyond %g times "
+                      "its area and sinks %d vertices into the skull",
+                      100 * faults.turned_share, 100 * faults.stretched_share, kTearStretch, faults.sunk);
+        if (found) {
+          share = found->first;
+          pose = std::move(found->second);
+          o.message += std::string(o.message.empty() ? "" : "; ") + std::string(what) + ": " +
+                       (reduced == all ? std::string("made at") : muscle_list(model, a, reduced) + " at") + " " +
                        std::to_string(static_cast<int>(std::lround(100 * share))) + " % of it";
         } else {
-          pose = Status::error(what + ", and so does " +
+          pose = Status::error(std::string(what) + ", and so does " +
                                std::to_string(static_cast<int>(std::lround(100 * std::ldexp(1.0, -kShareSteps)))) +
                                " % of it");
         }
@@ -212,7 +302,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         o.message = pose.status().message();
       } else {
         const Eigen::MatrixXd D = pose_epidermis(model, *pose) - skin.X0.topRows(skin.n);
-        if (a.jaw_open != 0) jaw = jaw_motion(model.jaw, share * a.jaw_open, 0, 0);
+        if (a.jaw_open != 0) jaw = jaw_motion(model.jaw, (reduced.back() ? share : 1) * a.jaw_open, 0, 0);
         o.made = true;
         o.largest = D.rowwise().norm().maxCoeff();
         o.dynamic = static_cast<int>(pose->dynamic.size());

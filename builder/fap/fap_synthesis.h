@@ -16,7 +16,12 @@
 // Visemes and expressions (fap_mapping.h, HighLevelMapping): the table's
 // muscles and jaw opening posed once; the target holds the skin and, when
 // the jaw opens, the jaw's rigid parts carried by it (these targets have no
-// rigid control).
+// rigid control). Where that pose tears the skin (SkinFaults::tears), the
+// muscles to blame (their influence holds the largest turned or stretched
+// triangles or a sunk vertex; both sides of a pair) are bisected to the
+// largest share that does not, to a sixteenth, the others kept; failing
+// that, everything together. The outcome's message says what is made at
+// what share.
 //
 // The scale is first found within the muscles' calibrated range (s <= 1,
 // s = 1: the table's contractions at 100 %). A group that falls short there
@@ -71,7 +76,9 @@ struct FapOutcome {
   // Visemes and expressions have no FDP rule: prescribed, achieved and the
   // errors stay zero; `largest` says how far the face moved.
   double largest = 0;             // the largest skin vertex displacement, model units
-  double scale = 0;               // muscle groups: the factor on the table's contractions
+  double scale = 0;               // muscle groups: the factor on the table's contractions;
+                                  // visemes and expressions: on the muscles the message
+                                  // names (1: the table's pose)
   int dynamic = 0;                // vertices solved
   double seconds = 0;
 };
