@@ -1,8 +1,9 @@
 // Builder benchmarks (issues 4 and 5): the full model build (25 muscles and
 // the jaw calibrated), the FAP targets and the AFM (the whole job of
-// afm-build -o) on the skin and on afm-build's default simulation mesh, time to equilibrium per muscle, dynamic sets against
-// whole-mesh solves, iterations when the epidermis is 10 times stiffer, and
-// the paper's solver beside the others, all in one run.
+// afm-build -o) on the skin and on afm-build's default simulation mesh,
+// time to equilibrium per muscle, dynamic sets against whole-mesh solves,
+// iterations when the epidermis is 10 times stiffer, and the paper's solver
+// beside the others, all in one run.
 //
 // Usage: bench_builder [SKIN_VERTICES] (default 10000). The Song head runs
 // too when ../shared/data is present. Figures are wall times of one run on a

@@ -155,8 +155,8 @@ Expected<std::vector<int>> wave_estimate(const FaceModel &model, const Muscle &m
 // 3.3): one equilibrium solve with the tension as an unknown (solver.h, load
 // control), on `set`, grown while the wave reaches its border.
 // *locked: it failed because the tissue locked before the key node got there.
-// *torn (when given): it failed because the pose that gets there tears the
-// skin (SkinFaults::tears).
+// *torn (when given): the pose that gets there tears the skin
+// (SkinFaults::tears); the tension is set all the same.
 Status calibrate_side(const FaceModel &model, Muscle &m, bool maximum, FactorCache *cache, std::vector<int> &set,
                       bool *locked, bool *torn) {
   LoadControl control;
@@ -173,11 +173,7 @@ Status calibrate_side(const FaceModel &model, Muscle &m, bool maximum, FactorCac
     return s.wrap("calibrating " + m.name + ": the " + (maximum ? "maximum" : "minimum") +
                   " contraction (moving its key node " + std::to_string(std::abs(control.value)) +
                   " model units) was not found");
-  if (torn && skin_faults(model, X.topRows(model.tissue.n)).tears()) {
-    *torn = true;
-    return Status::error("calibrating " + m.name + ": the " + (maximum ? "maximum" : "minimum") +
-                         " contraction tears the skin");
-  }
+  if (torn) *torn = skin_faults(model, X.topRows(model.tissue.n)).tears();
   (maximum ? m.tension_max : m.tension_min) = control.tension;
   return Status::ok();
 }
@@ -290,10 +286,7 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
         }
         // Torn even at an eighth: kept there, so that the FAPs and
         // expressions have the muscle; their own checks bound its share.
-        if (torn) {
-          tears = 2;
-          st = calibrate_side(model, m, maximum, &cache, *set, &locked, nullptr);
-        }
+        if (torn) tears = 2;
         return st;
       };
       if (s) s = side(false);
@@ -469,8 +462,6 @@ SkinFaults skin_faults(const FaceModel &model, const Eigen::MatrixXd &E) {
     const Eigen::Vector3d skull = s.X0.row(s.node(kSkull, v));
     if ((E.row(v).transpose() - skull).dot(s.normal.row(v).transpose()) < -model.quantum) out.sunk_vertices.push_back(v);
   }
-  out.flipped = static_cast<int>(out.turned_faces.size());
-  out.sunk = static_cast<int>(out.sunk_vertices.size());
   return out;
 }
 

@@ -158,15 +158,15 @@ Eigen::MatrixXd pose_epidermis(const FaceModel &model, const Pose &pose);
 constexpr double kTearStretch = 3;
 constexpr double kTornShare = 1e-4;
 struct SkinFaults {
-  int flipped = 0;                    // turned_faces.size()
-  int sunk = 0;                       // sunk_vertices.size()
   std::vector<int> turned_faces;      // skin triangles, ascending
   std::vector<int> stretched_faces;   // skin triangles, ascending
   std::vector<int> sunk_vertices;     // skin vertices, ascending
   double turned_share = 0;            // rest area of turned_faces over the skin's, 0..1
   double stretched_share = 0;         // rest area of stretched_faces over the skin's, 0..1
-  bool any() const { return flipped > 0 || sunk > 0; }
-  bool tears() const { return sunk > 0 || turned_share > kTornShare || stretched_share > kTornShare; }
+  bool any() const { return !turned_faces.empty() || !sunk_vertices.empty(); }
+  bool tears() const {
+    return !sunk_vertices.empty() || turned_share > kTornShare || stretched_share > kTornShare;
+  }
 };
 SkinFaults skin_faults(const FaceModel &model, const Eigen::MatrixXd &E);
 

@@ -129,6 +129,13 @@ std::vector<int> nearest_kept(const Part &skin, const std::vector<int> &kept) {
   return label;
 }
 
+// For each of the skin's `n` vertices, its coarse index, or -1.
+std::vector<int> coarse_index(const SimMesh &sim, int n) {
+  std::vector<int> out(static_cast<size_t>(n), -1);
+  for (size_t c = 0; c < sim.kept.size(); ++c) out[static_cast<size_t>(sim.kept[c])] = static_cast<int>(c);
+  return out;
+}
+
 // Binds every skin vertex to the coarse mesh (see the header).
 SkinBinding bind_fine_to_coarse(const Part &skin, const SimMesh &sim) {
   const int n = static_cast<int>(skin.V.rows());
@@ -136,8 +143,7 @@ SkinBinding bind_fine_to_coarse(const Part &skin, const SimMesh &sim) {
   std::vector<std::vector<int>> faces_of(static_cast<size_t>(nc));  // coarse faces at each coarse vertex
   for (Eigen::Index f = 0; f < sim.F.rows(); ++f)
     for (int k = 0; k < 3; ++k) faces_of[static_cast<size_t>(sim.F(f, k))].push_back(static_cast<int>(f));
-  std::vector<int> coarse_of(static_cast<size_t>(n), -1);
-  for (int c = 0; c < nc; ++c) coarse_of[static_cast<size_t>(sim.kept[static_cast<size_t>(c)])] = c;
+  const std::vector<int> coarse_of = coarse_index(sim, n);
   // Every vertex is kept when the mesh is the skin: nothing to search.
   const std::vector<int> label =
       sim.decimated ? nearest_kept(skin, sim.kept) : std::vector<int>(static_cast<size_t>(n), -1);
@@ -327,8 +333,7 @@ Scene sim_scene(const Scene &scene, const SimMesh &sim) {
 FdpSet sim_fdps(const FdpSet &fdps, const SimMesh &sim) {
   FdpSet out = fdps;
   if (!sim.decimated) return out;
-  std::vector<int> coarse_of(static_cast<size_t>(sim.binding.corner.rows()), -1);
-  for (size_t c = 0; c < sim.kept.size(); ++c) coarse_of[static_cast<size_t>(sim.kept[c])] = static_cast<int>(c);
+  const std::vector<int> coarse_of = coarse_index(sim, static_cast<int>(sim.binding.corner.rows()));
   for (FdpPoint &p : out.points)
     if (p.part == sim.skin && p.vertex >= 0) p.vertex = coarse_of[static_cast<size_t>(p.vertex)];
   return out;

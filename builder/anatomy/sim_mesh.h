@@ -20,11 +20,12 @@
 // half as long around the eyes and the mouth (the lids and lips need the
 // resolution). The lips keep every skin vertex within 0.2 eye separations
 // of a lip FDP (at most half the budget, nearest first): a decimated mouth
-// locks the sphincter of a detailed one (Song's). No collapse may turn a triangle's normal by more than 60
-// degrees from the skin normals it covers, leave a skin vertex more than
-// 0.03 eye separations from the coarse surface, or leave a triangle of
-// aspect ratio above 5, and the mesh stays a manifold with the same
-// boundaries (the mouth slit and eye openings).
+// locks the sphincter of a detailed one (Song's). No collapse may turn a
+// triangle's normal by more than 60 degrees from the skin normals it
+// covers, leave a skin vertex more than 0.03 eye separations from the
+// coarse surface, or leave a triangle of aspect ratio above 5, and the mesh
+// stays a manifold with the same boundaries (the mouth slit and eye
+// openings).
 //
 // Each skin vertex is bound to the nearest point of the coarse triangles
 // around its nearest kept vertex along the skin's edges, so a vertex of the
@@ -98,8 +99,8 @@ struct SimFaceModel {
 // the decimation keeps them), make_sim_mesh, then build_face_model on it. A
 // decimated mesh on which the model does not build (a coarse tissue that
 // cannot calibrate an essential muscle) is made again 1.5 times as fine, up
-// to the skin itself, whose failure is returned. `on_mesh`, when given, is called with each
-// simulation mesh before its model is built.
+// to the skin itself, whose failure is returned. `on_mesh`, when given, is
+// called with each simulation mesh before its model is built.
 Expected<SimFaceModel> build_sim_face_model(const Scene &scene, const FdpSet &fdps, SimMeshOptions sim_options,
                                             const FaceModelOptions &options,
                                             const std::function<void(const SimMesh &)> &on_mesh = {});

@@ -285,7 +285,8 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         std::snprintf(what, sizeof what,
                       "the table's pose turns %.2g %% of the skin's area over, stretches %.2g %% beyond %g times "
                       "its area and sinks %d vertices into the skull",
-                      100 * faults.turned_share, 100 * faults.stretched_share, kTearStretch, faults.sunk);
+                      100 * faults.turned_share, 100 * faults.stretched_share, kTearStretch,
+                      static_cast<int>(faults.sunk_vertices.size()));
         if (found) {
           share = found->first;
           pose = std::move(found->second);
