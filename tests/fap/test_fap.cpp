@@ -732,24 +732,24 @@ TEST(HighLevel, AnExpressionThatTearsTheSkinReducesTheMusclesThatTearIt) {
   const Eigen::MatrixXd X0 = m.tissue.X0.topRows(m.tissue.n);
   const SkinFaults made = skin_faults(m, X0 + D);
   EXPECT_FALSE(made.tears()) << made.turned_share << " turned, " << made.stretched_share << " stretched";
+  // The jaw opens until the chin (2.1) drops by the table's FAP 3 value.
+  const afm_fap_info *info = afm_fap(3);
+  const FdpPoint *chin = m.fdps.find(FdpId{info->fdp_group, info->fdp_index}, m.skin);
+  ASSERT_NE(chin, nullptr);
+  const Eigen::Vector3d c = X0.row(chin->vertex).transpose(), dir = fap_direction(info);
+  const double drop = h->jaw_open * fapu_distance(m.fapu, info->unit) / 1024.0;
+  double lo = 0, hi = 100;
+  for (int i = 0; i < 60; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    ((jaw_motion(m.jaw, mid, 0, 0) * c - c).dot(dir) < drop ? lo : hi) = mid;
+  }
   // The table's pose tears; the pose with the blamed muscles at the
-  // share and the rest at the table's is the target.
+  // share and the rest (risorius, the jaw) at the table's is the target.
   auto pose = [&](bool reduce) {
     Activation a;
-    for (const FapContraction &c : h->muscles) {
-      const bool blamed = c.muscle.rfind("risorius", 0) != 0;
-      a.muscles.push_back({m.find(c.muscle), c.percent * (reduce && blamed ? out.scale : 1.0)});
-    }
-    // The jaw opens until the chin (2.1) drops by the table's FAP 3 value.
-    const afm_fap_info *info = afm_fap(3);
-    const FdpPoint *chin = m.fdps.find(FdpId{info->fdp_group, info->fdp_index}, m.skin);
-    EXPECT_NE(chin, nullptr);
-    const Eigen::Vector3d c = X0.row(chin->vertex).transpose(), dir = fap_direction(info);
-    const double value = h->jaw_open * fapu_distance(m.fapu, info->unit) / 1024.0;
-    double lo = 0, hi = 100;
-    for (int i = 0; i < 60; ++i) {
-      const double mid = 0.5 * (lo + hi);
-      ((jaw_motion(m.jaw, mid, 0, 0) * c - c).dot(dir) < value ? lo : hi) = mid;
+    for (const FapContraction &k : h->muscles) {
+      const bool blamed = k.muscle.rfind("risorius", 0) != 0;
+      a.muscles.push_back({m.find(k.muscle), k.percent * (reduce && blamed ? out.scale : 1.0)});
     }
     a.jaw_open = 0.5 * (lo + hi);
     FactorCache cache;
@@ -759,6 +759,7 @@ TEST(HighLevel, AnExpressionThatTearsTheSkinReducesTheMusclesThatTearIt) {
   };
   const Eigen::MatrixXd table = pose(false), reduced = pose(true);
   ASSERT_EQ(table.rows(), D.rows());
+  ASSERT_EQ(reduced.rows(), D.rows());
   EXPECT_TRUE(skin_faults(m, X0 + table).tears());
   EXPECT_LT((D - reduced).rowwise().norm().maxCoeff(), 2 * m.quantum);
 }
