@@ -298,19 +298,24 @@ void element_volume_hessian(const SkinModel &m, const Eigen::MatrixXd &X, int f,
       h[0][0] = h[1][1] = h[2][2] = Eigen::Matrix3d::Zero();
       h[0][1] = -skew(e[2]) / 6, h[0][2] = skew(e[1]) / 6, h[1][2] = -skew(e[0]) / 6;
       h[1][0] = h[0][1].transpose(), h[2][0] = h[0][2].transpose(), h[2][1] = h[1][2].transpose();
-      // Points: p_{k+1} moves edge k; p0 moves all three edges the other way.
+      // Points: p_{k+1} moves edge k; p0 moves all three edges the other way,
+      // so p0's blocks are minus the sums over an edge index.
+      Eigen::Matrix3d b[4][4];
+      b[0][0].setZero();
+      for (int a = 0; a < 3; ++a) {
+        b[a + 1][0].setZero();
+        b[0][a + 1].setZero();
+        for (int c = 0; c < 3; ++c) {
+          b[a + 1][c + 1] = h[a][c];
+          b[a + 1][0] -= h[a][c];
+          b[0][a + 1] -= h[c][a];
+          b[0][0] += h[a][c];
+        }
+      }
       for (int i = 0; i < 4; ++i)
         for (int j = 0; j < 4; ++j) {
           const int ri = row[t[i]], rj = row[t[j]];
-          if (ri < 0 || rj < 0) continue;
-          Eigen::Matrix3d b = Eigen::Matrix3d::Zero();
-          for (int a = 0; a < 3; ++a)
-            for (int c = 0; c < 3; ++c) {
-              const double sa = i == 0 ? -1.0 : (i == a + 1 ? 1.0 : 0.0);
-              const double sc = j == 0 ? -1.0 : (j == c + 1 ? 1.0 : 0.0);
-              if (sa != 0 && sc != 0) b += sa * sc * h[a][c];
-            }
-          H->block<3, 3>(3 * ri, 3 * rj) += b;
+          if (ri >= 0 && rj >= 0) H->block<3, 3>(3 * ri, 3 * rj) += b[i][j];
         }
     }
   }

@@ -1,8 +1,9 @@
 #include "anatomy/solver.h"
 
+#include "anatomy/block_ldlt.h"
+
 #include <Eigen/Geometry>
 #include <Eigen/Sparse>
-#include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -15,7 +16,7 @@ namespace {
 
 using Vec = Eigen::VectorXd;
 using SpMat = Eigen::SparseMatrix<double>;
-using Ldlt = Eigen::SimplicialLDLT<SpMat, Eigen::Lower>;
+using Ldlt = BlockLdlt;
 
 // Elements whose rest volume is this small relative to the mean are left out
 // of the volume term: seen edge-on from the centre, their volume says nothing.
@@ -512,6 +513,7 @@ std::string number(double v) {
 struct FactorCache::Entry {
   std::unique_ptr<System> sys;
   Ldlt symbolic;  // analysed on the pattern; factorised per Newton step
+  bool analysed = false;  // the pattern is made of 3 x 3 blocks (always, by construction)
   std::unique_ptr<Ldlt> rest;
   bool rest_ok = false;
   int refresh_after = 0;  // newton: CG iterations worth a refactorisation (0: not known yet)
@@ -564,7 +566,7 @@ FactorCache::Entry *entry_for(const SkinModel &model, const std::vector<int> &ve
     if (FactorCache::Entry *e = cache->find(vertices); e && &e->sys->m == &model) return e;
   auto e = std::make_unique<FactorCache::Entry>();
   e->sys = std::make_unique<System>(model, vertices);
-  if (e->sys->dofs() > 0) e->symbolic.analyzePattern(e->sys->pattern);
+  if (e->sys->dofs() > 0) e->analysed = e->symbolic.analyze(e->sys->pattern);
   if (cache) return cache->insert(vertices, std::move(e));
   own = std::move(e);
   return own.get();
@@ -573,12 +575,11 @@ FactorCache::Entry *entry_for(const SkinModel &model, const std::vector<int> &ve
 // The rest-state Hessian's factorisation, computed once per entry.
 const Ldlt *rest_factor(FactorCache::Entry &e) {
   if (!e.rest) {
-    e.rest = std::make_unique<Ldlt>();
+    e.rest = std::make_unique<Ldlt>(e.symbolic);
     SpMat K;
     Vec diag;
     linearise(*e.sys, e.sys->m.X0, K, diag);
-    e.rest->compute(K);
-    e.rest_ok = e.rest->info() == Eigen::Success;
+    e.rest_ok = e.analysed && e.rest->factorize(K) != Ldlt::Result::kSingular;
   }
   return e.rest_ok ? e.rest.get() : nullptr;
 }
@@ -606,7 +607,8 @@ Expected<Eigen::MatrixXd> linear_response(const SkinModel &model, const std::vec
   if (!rest) return Status::error("linear response: the rest-state Hessian is singular");
   Eigen::MatrixXd F = Eigen::MatrixXd::Zero(model.X0.rows(), 3);
   load(model.X0, &F, nullptr);  // the tissue's own stiffness: the wave's reach
-  const Vec u = rest->solve(gather_rows(*e->sys, F));
+  Vec u;
+  rest->solve(gather_rows(*e->sys, F), u);
   if (!finite(u)) return Status::error("linear response: non-finite displacement");
   scatter_rows(*e->sys, u, out);
   return out;
@@ -636,6 +638,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
   const int n = sys.dofs();
   st.unknowns = n;
   if (n == 0) return done(!control, control ? "solver: the dynamic set is empty" : "");
+  if (!entry->analysed) return done(false, "solver: the tangent's pattern is not made of 3 x 3 blocks");
 
   Contacts contacts;
   update_contacts(sys, X, contacts);
@@ -737,7 +740,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
   auto linear_solve = [&](const Vec &b, Vec &x, bool *indefinite, int max_cg) {
     auto apply = [&](const Vec &p, Vec &out) { out.noalias() = K * p; };
     if (factor)
-      return filtered_pcg(apply, [&](const Vec &in, Vec &out) { out = factor->solve(in); }, contacts, b, x,
+      return filtered_pcg(apply, [&](const Vec &in, Vec &out) { factor->solve(in, out); }, contacts, b, x,
                           max_cg, options.cg_relative, indefinite);
     return filtered_pcg(apply, jacobi(diag), contacts, b, x, max_cg, options.cg_relative, indefinite);
   };
@@ -780,25 +783,20 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
       for (;;) {
         Kf = K;
         contacts.filter(sys, Kf);
-        entry->symbolic.factorize(Kf);
+        const Ldlt::Result res = entry->symbolic.factorize(Kf);
         ++st.factorisations;
-        const bool ok = entry->symbolic.info() == Eigen::Success;
-        if (ok && (!full || (entry->symbolic.vectorD().array() > 0).all())) break;
+        const bool ok = res != Ldlt::Result::kSingular;
+        if (ok && (!full || res == Ldlt::Result::kDefinite)) break;
         if (!full) return false;
         project();
       }
       factor = &entry->symbolic;
       if (entry->refresh_after == 0) {
-        // A factorisation costs sum_j c_j^2 (c_j: column j of L), a CG
-        // iteration about 4 nnz(L) + nnz(K): refresh once CG spends a third
-        // of a factorisation.
-        const SpMat &L = entry->symbolic.matrixL().nestedExpression();
-        double flops = 0;
-        for (Eigen::Index j = 0; j < L.cols(); ++j) {
-          const double c = L.outerIndexPtr()[j + 1] - L.outerIndexPtr()[j];
-          flops += c * c;
-        }
-        const double ratio = flops / (4.0 * static_cast<double>(L.nonZeros()) + static_cast<double>(K.nonZeros()));
+        // A factorisation costs sum_j c_j^2 (c_j: scalar column j of L), a
+        // CG iteration about 4 nnz(L) + nnz(K): refresh once CG spends a
+        // third of a factorisation.
+        const double ratio = entry->symbolic.factor_flops() /
+                             (4.0 * entry->symbolic.nonzeros() + static_cast<double>(K.nonZeros()));
         entry->refresh_after = std::max(kRefresh, static_cast<int>(ratio / 3));
       }
       return true;

@@ -42,8 +42,8 @@
 // Solvers (bench_builder compares them; docs/anatomy.md has the figures):
 //   newton          Newton's method on the static equations. The step solves
 //                   the (constraint-filtered) tangent system with CG
-//                   preconditioned by a Cholesky (LDLT) factorisation of the
-//                   filtered tangent itself, so CG takes one or two
+//                   preconditioned by an LDL^T factorisation (block_ldlt.h) of
+//                   the filtered tangent itself, so CG takes one or two
 //                   iterations; the factorisation is reused while CG stays
 //                   cheap and refreshed once a linear solve spends over a
 //                   third of a factorisation's cost in CG iterations (counted

@@ -1,0 +1,158 @@
+// The solver's block factorisation (anatomy/block_ldlt.h) against Eigen's
+// dense factorisations of the same matrices: an independent reference.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+#include <random>
+#include <vector>
+
+#include "anatomy/block_ldlt.h"
+
+using namespace afmb;
+
+namespace {
+
+using SpMat = Eigen::SparseMatrix<double>;
+
+// A symmetric matrix of full 3 x 3 blocks on the nodes of an nx x ny x nz
+// grid (each node coupled to its 26 neighbours, as the tissue's prisms
+// couple nodes across layers), diagonally dominant by `margin` times the
+// off-diagonal sum: positive definite for margin > 1. Node numbers are
+// shuffled so that the ordering has work to do.
+SpMat grid_matrix(int nx, int ny, int nz, double margin, unsigned seed) {
+  const int n = nx * ny * nz;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<int> label(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) label[static_cast<size_t>(i)] = i;
+  std::shuffle(label.begin(), label.end(), rng);
+  auto id = [&](int x, int y, int z) { return label[static_cast<size_t>((z * ny + y) * nx + x)]; };
+  Eigen::MatrixXd rowsum = Eigen::MatrixXd::Zero(3 * n, 1);
+  std::vector<Eigen::Triplet<double>> t;
+  for (int z = 0; z < nz; ++z)
+    for (int y = 0; y < ny; ++y)
+      for (int x = 0; x < nx; ++x)
+        for (int dz = -1; dz <= 1; ++dz)
+          for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+              const int X = x + dx, Y = y + dy, Z = z + dz;
+              if (X < 0 || Y < 0 || Z < 0 || X >= nx || Y >= ny || Z >= nz) continue;
+              const int i = id(x, y, z), j = id(X, Y, Z);
+              if (j <= i && !(dx == 0 && dy == 0 && dz == 0)) continue;  // each pair once
+              if (i == j) continue;
+              Eigen::Matrix3d B;
+              for (int a = 0; a < 3; ++a)
+                for (int b = 0; b < 3; ++b) B(a, b) = u(rng);
+              for (int a = 0; a < 3; ++a)
+                for (int b = 0; b < 3; ++b) {
+                  t.emplace_back(3 * i + a, 3 * j + b, B(a, b));
+                  t.emplace_back(3 * j + b, 3 * i + a, B(a, b));
+                  rowsum(3 * i + a) += std::abs(B(a, b));
+                  rowsum(3 * j + b) += std::abs(B(a, b));
+                }
+            }
+  for (int i = 0; i < n; ++i) {
+    Eigen::Matrix3d S;
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) S(a, b) = 0.1 * u(rng);
+    S = 0.5 * (S + S.transpose()).eval();
+    for (int a = 0; a < 3; ++a) {
+      double off = 0;
+      for (int b = 0; b < 3; ++b) off += b == a ? 0 : std::abs(S(a, b));
+      S(a, a) = margin * (rowsum(3 * i + a) + off);
+    }
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) t.emplace_back(3 * i + a, 3 * i + b, S(a, b));
+  }
+  SpMat K(3 * n, 3 * n);
+  K.setFromTriplets(t.begin(), t.end());
+  K.makeCompressed();
+  return K;
+}
+
+Eigen::VectorXd random_vector(Eigen::Index n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1, 1);
+  Eigen::VectorXd b(n);
+  for (Eigen::Index i = 0; i < n; ++i) b(i) = u(rng);
+  return b;
+}
+
+}  // namespace
+
+TEST(BlockLdlt, SolvesAPositiveDefiniteSystemAsADenseCholeskyDoes) {
+  const SpMat K = grid_matrix(6, 5, 4, 1.05, 1);
+  BlockLdlt f;
+  ASSERT_TRUE(f.analyze(K));
+  EXPECT_EQ(f.factorize(K), BlockLdlt::Result::kDefinite);
+  const Eigen::VectorXd b = random_vector(K.rows(), 2);
+  Eigen::VectorXd x;
+  f.solve(b, x);
+  const Eigen::MatrixXd dense = Eigen::MatrixXd(K);
+  const Eigen::VectorXd ref = dense.llt().solve(b);
+  EXPECT_LT((x - ref).norm(), 1e-10 * ref.norm());
+  // The ordering keeps the fill near a scalar AMD ordering's (Eigen's
+  // simplicial factorisation of the same matrix); a second factorisation
+  // of the same pattern gives the same solution.
+  Eigen::SimplicialLDLT<SpMat> scalar(K);
+  ASSERT_EQ(scalar.info(), Eigen::Success);
+  const double scalar_nonzeros = static_cast<double>(scalar.matrixL().nestedExpression().nonZeros());
+  EXPECT_LT(f.nonzeros(), 1.3 * scalar_nonzeros) << "scalar AMD: " << scalar_nonzeros;
+  const SpMat K2 = 2.0 * K;
+  EXPECT_EQ(f.factorize(K2), BlockLdlt::Result::kDefinite);
+  Eigen::VectorXd x2;
+  f.solve(b, x2);
+  EXPECT_LT((2 * x2 - ref).norm(), 1e-10 * ref.norm());
+}
+
+TEST(BlockLdlt, SaysWhenTheMatrixIsIndefiniteAndStillSolvesIt) {
+  // Shifting by the middle eigenvalue leaves about half of them negative.
+  SpMat K = grid_matrix(4, 4, 3, 1.05, 3);
+  const Eigen::MatrixXd dense = Eigen::MatrixXd(K);
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(dense);
+  const Eigen::VectorXd ev = eig.eigenvalues();
+  const double shift = 0.5 * (ev(ev.size() / 2) + ev(ev.size() / 2 + 1));
+  SpMat I(K.rows(), K.cols());
+  I.setIdentity();
+  K = K - shift * I;  // the same pattern: the identity's entries are in it
+  BlockLdlt f;
+  ASSERT_TRUE(f.analyze(K));
+  EXPECT_EQ(f.factorize(K), BlockLdlt::Result::kIndefinite);
+  const Eigen::VectorXd b = random_vector(K.rows(), 4);
+  Eigen::VectorXd x;
+  f.solve(b, x);
+  const Eigen::VectorXd ref = Eigen::MatrixXd(K).partialPivLu().solve(b);
+  EXPECT_LT((x - ref).norm(), 1e-8 * ref.norm());
+}
+
+TEST(BlockLdlt, RefusesASingularMatrix) {
+  SpMat K = grid_matrix(3, 3, 2, 1.05, 5);
+  // One node's rows and columns zero: its pivot block vanishes.
+  for (int k = 0; k < K.outerSize(); ++k)
+    for (SpMat::InnerIterator it(K, k); it; ++it)
+      if (it.row() / 3 == 7 || it.col() / 3 == 7) it.valueRef() = 0;
+  BlockLdlt f;
+  ASSERT_TRUE(f.analyze(K));
+  EXPECT_EQ(f.factorize(K), BlockLdlt::Result::kSingular);
+}
+
+TEST(BlockLdlt, RefusesAPatternThatIsNotMadeOfBlocks) {
+  SpMat K = grid_matrix(3, 2, 2, 1.05, 6);
+  BlockLdlt f;
+  ASSERT_TRUE(f.analyze(K));
+  // One entry less: its block is no longer full.
+  std::vector<Eigen::Triplet<double>> t;
+  for (int k = 0; k < K.outerSize(); ++k)
+    for (SpMat::InnerIterator it(K, k); it; ++it)
+      if (!(it.row() == 4 && it.col() == 3)) t.emplace_back(static_cast<int>(it.row()), static_cast<int>(it.col()), it.value());
+  SpMat holed(K.rows(), K.cols());
+  holed.setFromTriplets(t.begin(), t.end());
+  EXPECT_FALSE(f.analyze(holed));
+  // Not a multiple of three.
+  SpMat odd(7, 7);
+  odd.setIdentity();
+  odd.makeCompressed();
+  EXPECT_FALSE(f.analyze(odd));
+}
