@@ -402,23 +402,39 @@ Expected<Pose> solve_pose(const FaceModel &model, const Activation &a, FactorCac
   std::vector<int> set;
   if (Status s = muscle_set(model, a.muscles, set); !s) return s;
   const bool jaw_moves = a.jaw_open != 0 || a.jaw_thrust != 0 || a.jaw_shift != 0;
+  auto join = [&set](const std::vector<int> &more) {
+    std::vector<int> u;
+    std::set_union(set.begin(), set.end(), more.begin(), more.end(), std::back_inserter(u));
+    set = std::move(u);
+  };
   if (jaw_moves) {
     if (a.jaw_open < 0) return Status::error("pose: the jaw does not open by a negative amount");
-    const Eigen::Affine3d t = jaw_motion(model.jaw, a.jaw_open, a.jaw_thrust, a.jaw_shift);
+    pose.jaw = jaw_motion(model.jaw, a.jaw_open, a.jaw_thrust, a.jaw_shift);
     for (int v : model.jaw.vertices)
       for (int l = 0; l < kTissueLayers; ++l) {
         const int g = skin.node(l, v);
-        pose.X.row(g) = (t * Eigen::Vector3d(skin.X0.row(g))).transpose();
+        pose.X.row(g) = (pose.jaw * Eigen::Vector3d(skin.X0.row(g))).transpose();
       }
-    const std::vector<int> &own = model.jaw.dynamic.empty() ? model.jaw.vertices : model.jaw.dynamic;
-    std::vector<int> u;
-    std::set_union(set.begin(), set.end(), own.begin(), own.end(), std::back_inserter(u));
-    set = std::move(u);
+    join(model.jaw.dynamic.empty() ? model.jaw.vertices : model.jaw.dynamic);
+  }
+  const Eigen::MatrixXd reference = pose.X;  // the rest state, carried by the jaw
+  if (const Pose *from = options.start) {
+    // Its free nodes as the first guess; the skull nodes (fixed) stay this
+    // pose's own, exactly.
+    join(from->dynamic);
+    const Eigen::Affine3d carry = pose.jaw * from->jaw.inverse();
+    std::vector<char> on_jaw(static_cast<size_t>(skin.n), 0);
+    for (int v : model.jaw.vertices) on_jaw[static_cast<size_t>(v)] = 1;
+    for (int v : from->dynamic)
+      for (int l = 0; l < kSkull; ++l) {
+        const int g = skin.node(l, v);
+        const Eigen::Vector3d x = from->X.row(g).transpose();
+        pose.X.row(g) = (on_jaw[static_cast<size_t>(v)] ? Eigen::Vector3d(carry * x) : x).transpose();
+      }
   }
   if (set.empty() && !options.whole_mesh) return pose;
   const SolverOptions &opts = options.solver ? *options.solver : model.solver;
   FactorCache local;
-  const Eigen::MatrixXd reference = pose.X;  // the rest state, carried by the jaw
   Status s = solve_growing(model, set, activation_forces(model, a.muscles), reference, pose.X, opts,
                            model.wave_threshold, cache ? cache : &local,
                            options.whole_mesh, &pose.stats, &pose.rounds);

@@ -95,9 +95,18 @@ struct Activation {
   double jaw_open = 0, jaw_thrust = 0, jaw_shift = 0;  // percent (open >= 0)
 };
 
+struct Pose;
+
 struct PoseOptions {
   bool whole_mesh = false;  // solve on every skin vertex instead of the dynamic set
   const SolverOptions *solver = nullptr;  // override the model's
+  // Start from this pose (a solve_pose result of the same model) instead of
+  // the rest state: its nodes are the first guess, the jaw's vertices carried
+  // from its jaw motion to this one's, and its dynamic set joins this one's.
+  // A nearby activation then takes a few Newton iterations instead of a solve
+  // from rest, and follows the same branch where the tissue has two
+  // equilibria (the skull and eyeball contacts). Null: from rest.
+  const Pose *start = nullptr;
 };
 
 struct Pose {
@@ -105,6 +114,7 @@ struct Pose {
   std::vector<int> dynamic;   // the vertices solved, sorted
   SolveStats stats;           // of the last solve (summed iterations over the growth rounds)
   int rounds = 0;             // solves (1 + growth rounds)
+  Eigen::Affine3d jaw = Eigen::Affine3d::Identity();  // the jaw's motion in it
 };
 
 // Fails when the solver fails (the message says why); never returns an

@@ -235,12 +235,15 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       FactorCache cache;
       // `reduced` marks the muscles (one per a.muscles entry, then the jaw)
       // that `share` scales; the others keep the table's contraction.
-      auto solve_share = [&](const std::vector<char> &reduced, double share) {
+      // `from`: a pose of a smaller share of the same muscles (solve_pose).
+      auto solve_share = [&](const std::vector<char> &reduced, double share, const Pose *from = nullptr) {
         Activation b = a;
         for (size_t k = 0; k < b.muscles.size(); ++k)
           if (reduced[k]) b.muscles[k].second *= share;
         if (reduced.back()) b.jaw_open *= share;
-        return solve_pose(model, b, &cache);
+        PoseOptions po;
+        po.start = from;
+        return solve_pose(model, b, &cache, po);
       };
       // The table's pose. Where it tears the skin (joy turned the crease at
       // Song's left eye's outer corner over), the largest share of the
@@ -263,7 +266,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
           std::optional<Pose> kept;
           for (int step = 0; step < kShareSteps; ++step) {
             const double mid = 0.5 * (lo + hi);
-            Expected<Pose> p = solve_share(which, mid);
+            Expected<Pose> p = solve_share(which, mid, kept ? &*kept : nullptr);
             if (p && !torn(*p)) {
               lo = mid;
               kept = std::move(*p);
@@ -357,10 +360,17 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         const Eigen::Vector3d p = skin.X0.row(fdp->vertex).transpose();
         // The jaw moves the bone; the skin over it follows through the
         // tissue, a few percent short or beyond. So: the bone's motion at
-        // the FDP first, then secant steps on the solved pose.
+        // the FDP first, then secant steps on the solved pose. Each round
+        // starts from the pose of the largest motion solved so far that does
+        // not pass its own, as the jaw loads the tissue, else from rest: a few
+        // Newton iterations instead of a solve from rest, and the rounds stay
+        // on one branch where the tissue snaps through (at Song's chin the
+        // midline buckles at 20 % open; rounds from rest landed on either side
+        // and the secant did not converge).
         double pct = jaw_percent(model.jaw, map->driver, p, side * dir, value);
         FactorCache cache;
         Expected<Pose> pz = Status::error("no pose");
+        std::vector<std::pair<double, Pose>> solved;  // |pct| and its pose
         double prev_pct = 0, prev_along = 0, posed = pct;
         for (int round = 0; round < 6; ++round) {
           posed = pct;
@@ -368,10 +378,15 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
           (map->driver == FapDriver::JawOpen    ? a.jaw_open
            : map->driver == FapDriver::JawThrust ? a.jaw_thrust
                                                  : a.jaw_shift) = pct;
-          pz = solve_pose(model, a, &cache);
+          PoseOptions po;
+          double from = -1;
+          for (const auto &[at, q] : solved)
+            if (at <= std::abs(pct) && at > from) po.start = &q, from = at;
+          pz = solve_pose(model, a, &cache, po);
           if (!pz) break;
           const double along = (pz->X.row(fdp->vertex) - skin.X0.row(fdp->vertex)).dot(side * dir.transpose());
           if (std::abs(along - value) <= model.solver.tolerance) break;
+          solved.emplace_back(std::abs(pct), *pz);
           const double next = prev_along != along ? pct + (value - along) * (pct - prev_pct) / (along - prev_along)
                                                   : pct * value / along;
           prev_pct = pct, prev_along = along;
@@ -429,11 +444,15 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         // short there may pass it, its tensions extrapolated up to
         // kMaxFapScale, in one more solve from the pose at s = 1 with a
         // budget of Newton iterations; that pose is kept only if the skin
-        // stays a face.
+        // stays a face. Where the skin already folds at s = 1, no more solve:
+        // on Song all 12 such groups folded beyond too, at about 18 Newton
+        // iterations each.
         double cap = 1;
         Expected<Pose> pz = solve_pose_to(model, pattern, action, value, &cache, &scale, cap, &capped);
         std::string beyond_why;  // why the group stayed within its range
-        if (pz && capped) {
+        if (pz && capped && skin_faults(model, pose_epidermis(model, *pz)).any()) {
+          beyond_why = "the skin folds or sinks into the skull already at them";
+        } else if (pz && capped) {
           SteerFrom from;
           from.pose = &*pz;
           from.scale = scale;

@@ -7,7 +7,8 @@
 // reference x FAPU along the FAP's direction (negative side: -reference);
 // the pose's epidermis minus the rest is the target. The jaw FAPs (3, 14,
 // 15) set the jaw's rotation or translation so that the chin (2.1) moves by
-// the same rule, then solve the tissue around it; the jaw's rigid parts
+// the same rule, then solve the tissue around it (secant steps, each from
+// the pose of the largest motion solved so far not past its own); the jaw's rigid parts
 // (lower teeth, tongue) get a control with the same motion.
 //
 // Every target also carries the parts that ride on the skin (lashes, lid
@@ -27,9 +28,9 @@
 // s = 1: the table's contractions at 100 %). A group that falls short there
 // gets one more solve, from that pose, that may pass the range with its
 // tensions extrapolated up to kMaxFapScale, within a budget of Newton
-// iterations; its pose is kept if the skin stays a face (face_model.h,
-// skin_faults: no skin triangle turned over, nothing below the skull),
-// else the pose at s = 1 is. A group that cannot reach the reference makes
+// iterations (none where the skin already folds at s = 1); its pose is kept
+// if the skin stays a face (face_model.h, skin_faults: no skin triangle
+// turned over, nothing below the skull), else the pose at s = 1 is. A group that cannot reach the reference makes
 // its target at that cap and keeps the table's reference: the target
 // under-reaches (the outcome says by how much and why), and a stream at the
 // reference shows the muscles at their most. (Lowering the reference to

@@ -439,6 +439,35 @@ TEST(Physics, TheJawOpens) {
   }
 }
 
+TEST(Physics, APoseStartedFromANearbyOneIsTheSameEquilibrium) {
+  // The jaw's secant steps (fap_synthesis.h) start each solve from an earlier
+  // pose: the jaw's vertices are carried from its motion to the new one.
+  const FaceModel &m = head_1k().model;
+  FactorCache cache;
+  Activation a30, a50;
+  a30.jaw_open = 30;
+  a50.jaw_open = 50;
+  Expected<Pose> p30 = solve_pose(m, a30, &cache);
+  Expected<Pose> rest = solve_pose(m, a50, &cache);
+  ASSERT_TRUE(p30.is_ok() && rest.is_ok());
+  PoseOptions po;
+  po.start = &*p30;
+  Expected<Pose> warm = solve_pose(m, a50, &cache, po);
+  ASSERT_TRUE(warm.is_ok()) << warm.status().message();
+  EXPECT_LE((pose_epidermis(m, *warm) - pose_epidermis(m, *rest)).cwiseAbs().maxCoeff(), m.quantum);
+  EXPECT_LT(warm->stats.iterations, rest->stats.iterations);
+  EXPECT_TRUE(warm->jaw.isApprox(rest->jaw, 0));
+  EXPECT_TRUE(std::includes(warm->dynamic.begin(), warm->dynamic.end(), p30->dynamic.begin(), p30->dynamic.end()));
+  // The skull stays where the new jaw puts it, exactly.
+  for (int v : m.jaw.vertices) {
+    const int g = m.tissue.node(kSkull, v);
+    EXPECT_EQ(warm->X.row(g), rest->X.row(g)) << "vertex " << v;
+  }
+  EXPECT_EQ(penetrating_nodes(m.tissue, warm->X, 1e-9), 0);
+  std::printf("jaw 50 %%: %d Newton iterations from rest, %d from the pose at 30 %%\n", rest->stats.iterations,
+              warm->stats.iterations);
+}
+
 TEST(Physics, ResidualBelowToleranceAtTheEnd) {
   const FaceModel &m = head_1k().model;
   const int i = m.find("zygomaticus_major_left");

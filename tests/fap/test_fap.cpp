@@ -190,10 +190,10 @@ TEST(FapSynthesis, EachTargetMovesItsFdpByReferenceTimesFapuAlongTheFapsDirectio
     // A group that under-reaches says how far it gets (reached < 1).
     EXPECT_TRUE(o.reached > 0 && o.reached <= 1) << o.reached;
     const double want = o.reached * t->reference * unit;
-    // Muscles: to the solver tolerance. The jaw: its chin is carried rigidly
-    // but the tissue around it settles, so within 5 %.
-    const double tol = o.number == 3 ? 0.05 * std::abs(want) : 4 * m.solver.tolerance;
-    EXPECT_NEAR(along, want, tol);
+    // To the solver tolerance: the muscles' load control, and the jaw's secant
+    // steps on the solved pose (its chin is carried rigidly, the tissue
+    // around it settles a few percent short or beyond).
+    EXPECT_NEAR(along, want, 4 * m.solver.tolerance) << "FAP " << o.number;
     // Only the solved vertices move.
     int moved = 0;
     for (Eigen::Index v = 0; v < D.rows(); ++v) moved += D.row(v).norm() > 0;
