@@ -6,6 +6,7 @@
 #include <vector>
 
 #include <algorithm>
+#include <unistd.h>
 
 #include "afm/afm_export.h"
 #include "anatomy/face_model.h"
@@ -85,7 +86,9 @@ void usage(FILE *out) {
       "  --list-faps             how each FAP, viseme and expression is made: muscles,\n"
       "                          jaw, rigid or not at all\n"
       "  --list-muscles          the 25 muscles and their key points\n"
-      "  -q, --quiet             no progress lines\n"
+      "  -q, --quiet             no progress on stderr (else one line rewritten in\n"
+      "                          place, or a line per tenth of the work when stderr\n"
+      "                          is not a terminal)\n"
       "  --help                  this text\n"
       "\n"
       "Exit status: 0 on success (FAPs that cannot be made are reported, not fatal), 1\n"
@@ -93,11 +96,26 @@ void usage(FILE *out) {
       "why), 2 on bad usage.\n", kDefaultSimVertices, kMaxFapScale);
 }
 
-// One line on stderr, rewritten in place: "[done/total] what".
+bool stderr_is_terminal() {
+  static const bool tty = isatty(fileno(stderr)) != 0;
+  return tty;
+}
+
+// Progress on stderr, "[done/total] what": on a terminal one line rewritten
+// in place; in a log (not a terminal) a line at each tenth of the work.
 void progress_line(int done, int total, const std::string &what) {
-  std::fprintf(stderr, "\r[%3d/%3d] %-40s", done, total, what.c_str());
-  if (done == total) std::fprintf(stderr, "\n");
+  if (stderr_is_terminal()) {
+    std::fprintf(stderr, "\r[%3d/%3d] %-40s", done, total, what.c_str());
+    if (done == total) std::fprintf(stderr, "\n");
+  } else if (done == total || done * 10 / total != (done - 1) * 10 / total) {
+    std::fprintf(stderr, "[%3d/%3d] %s\n", done, total, what.c_str());
+  }
   std::fflush(stderr);
+}
+
+// Ends a progress line cut short (a terminal's only).
+void end_progress() {
+  if (stderr_is_terminal()) std::fprintf(stderr, "\n");
 }
 
 int fail(const Status &s) {
@@ -278,12 +296,12 @@ int main(int argc, char **argv) {
   if (!quiet) fo.progress = progress_line;
   int meshes = 0;
   Expected<SimFaceModel> built = build_sim_face_model(face->scene, face->fdps, sm, fo, [&](const SimMesh &m) {
-    if (!quiet && meshes++ > 0) std::fprintf(stderr, "\n");  // after the failed build's progress
+    if (!quiet && meshes++ > 0) end_progress();  // after the failed build's progress
     if (m.decimated)
       std::printf("simulation mesh: %zu of the skin's %lld vertices, %lld triangles (%.2f s)\n", m.kept.size(),
                   static_cast<long long>(m.binding.corner.rows()), static_cast<long long>(m.F.rows()), m.seconds);
   });
-  if (!quiet) std::fprintf(stderr, "\n");
+  if (!quiet) end_progress();
   if (!built) return fail(built.status().wrap(mesh_path));
   for (const std::string &n : built->notes) std::printf("note: %s\n", n.c_str());
   const SimMesh *sim = &built->sim;
