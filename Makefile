@@ -116,6 +116,10 @@ ifeq ($(config),release)
 $(B)/obj/player_c/src/%.c.o: CFLAGS += -O3
 # Benchmarks at the same level, so their float reference loops vectorise too.
 $(B)/obj/bench/%.cpp.o: CXXFLAGS += -O3
+# The solver's kernels (factorisation, block products, Hessians): about a
+# tenth less time on Song's AFM, and the same bytes (no -ffast-math, no FMA
+# on the baseline x86-64 target).
+$(B)/obj/builder/anatomy/%.cpp.o: CXXFLAGS += -O3
 endif
 
 $(B)/obj/%.cpp.o: %.cpp
