@@ -175,6 +175,13 @@ Status calibrate_side(const FaceModel &model, Muscle &m, bool maximum, FactorCac
                   " model units) was not found");
   if (torn) *torn = skin_faults(model, X.topRows(model.tissue.n)).tears();
   (maximum ? m.tension_max : m.tension_min) = control.tension;
+  Muscle::Response &r = maximum ? m.response_max : m.response_min;
+  r.nodes.clear();
+  for (Eigen::Index g = 0; g < X.rows(); ++g)
+    if (X.row(g) != model.tissue.X0.row(g)) r.nodes.push_back(static_cast<int>(g));
+  r.displacement.resize(static_cast<Eigen::Index>(r.nodes.size()), 3);
+  for (size_t i = 0; i < r.nodes.size(); ++i)
+    r.displacement.row(static_cast<Eigen::Index>(i)) = X.row(r.nodes[i]) - model.tissue.X0.row(r.nodes[i]);
   return Status::ok();
 }
 
@@ -445,6 +452,23 @@ Expected<Pose> solve_pose(const FaceModel &model, const Activation &a, FactorCac
 
 Eigen::MatrixXd pose_epidermis(const FaceModel &model, const Pose &pose) {
   return pose.X.topRows(model.tissue.n);
+}
+
+Pose superposed_pose(const FaceModel &model, const std::vector<std::pair<int, double>> &muscles) {
+  Pose out;
+  out.X = model.tissue.X0;
+  for (const auto &[i, pct] : muscles) {
+    if (i < 0 || i >= static_cast<int>(model.muscles.size()) || pct == 0) continue;
+    const Muscle &m = model.muscles[static_cast<size_t>(i)];
+    const Muscle::Response &r = pct > 0 ? m.response_max : m.response_min;
+    for (size_t k = 0; k < r.nodes.size(); ++k)
+      out.X.row(r.nodes[k]) += std::abs(pct) / 100 * r.displacement.row(static_cast<Eigen::Index>(k));
+    const std::vector<int> &own = m.dynamic.empty() ? m.influence : m.dynamic;
+    std::vector<int> u;
+    std::set_union(out.dynamic.begin(), out.dynamic.end(), own.begin(), own.end(), std::back_inserter(u));
+    out.dynamic = std::move(u);
+  }
+  return out;
 }
 
 SkinFaults skin_faults(const FaceModel &model, const Eigen::MatrixXd &E) {

@@ -235,14 +235,17 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       FactorCache cache;
       // `reduced` marks the muscles (one per a.muscles entry, then the jaw)
       // that `share` scales; the others keep the table's contraction.
-      // `from`: a pose of a smaller share of the same muscles (solve_pose).
+      // Each solve starts from `from` (a pose of a smaller share of the same
+      // muscles), else from the muscles' calibrated poses added
+      // (superposed_pose): half the Newton iterations of a start from rest.
       auto solve_share = [&](const std::vector<char> &reduced, double share, const Pose *from = nullptr) {
         Activation b = a;
         for (size_t k = 0; k < b.muscles.size(); ++k)
           if (reduced[k]) b.muscles[k].second *= share;
         if (reduced.back()) b.jaw_open *= share;
+        const Pose guess = from ? Pose() : superposed_pose(model, b.muscles);
         PoseOptions po;
-        po.start = from;
+        po.start = from ? from : &guess;
         return solve_pose(model, b, &cache, po);
       };
       // The table's pose. Where it tears the skin (joy turned the crease at
@@ -448,7 +451,20 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         // on Song all 12 such groups folded beyond too, at about 18 Newton
         // iterations each.
         double cap = 1;
-        Expected<Pose> pz = solve_pose_to(model, pattern, action, value, &cache, &scale, cap, &capped);
+        // The first guess: the muscles' calibrated poses added, scaled by the
+        // share that would bring the FDP to the value if the tissue were
+        // linear (within the range).
+        const Pose sum = superposed_pose(model, pattern);
+        const double sum_action = action(sum.X, nullptr);
+        Pose guess = sum;
+        SteerFrom first;
+        if (sum_action > 0) {
+          first.scale = std::clamp(value / sum_action, 1.0 / 16, cap);
+          guess.X = skin.X0 + first.scale * (sum.X - skin.X0);
+          first.pose = &guess;
+        }
+        Expected<Pose> pz = solve_pose_to(model, pattern, action, value, &cache, &scale, cap, &capped,
+                                          first.pose ? &first : nullptr);
         std::string beyond_why;  // why the group stayed within its range
         if (pz && capped && skin_faults(model, pose_epidermis(model, *pz)).any()) {
           beyond_why = "the skin folds or sinks into the skull already at them";
@@ -488,7 +504,9 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
           if (!full) {
             Activation a;
             a.muscles = pattern;
-            full = solve_pose(model, a, &cache);
+            PoseOptions po;
+            po.start = &sum;
+            full = solve_pose(model, a, &cache, po);
           }
           if (!full) {
             o.message = full.status().message();

@@ -50,6 +50,14 @@ Expected<FaceModel> song_model(const LoadedFace &f, const std::string &muscle) {
   return build_face_model(f.scene, f.fdps, fo);
 }
 
+// The shared 1k head's model with only `muscles` calibrated and no jaw.
+Expected<FaceModel> model_1k(const std::vector<std::string> &muscles) {
+  FaceModelOptions fo;
+  fo.calibrate_only = muscles;
+  fo.calibrate_jaw = false;
+  return build_face_model(head_1k().head.scene, head_1k().head.fdps, fo);
+}
+
 // The set without FDP `id`.
 FdpSet without(FdpSet f, const std::string &id) {
   f.points.erase(std::remove_if(f.points.begin(), f.points.end(), [&](const FdpPoint &p) { return p.id.str() == id; }),
@@ -468,6 +476,48 @@ TEST(Physics, APoseStartedFromANearbyOneIsTheSameEquilibrium) {
               warm->stats.iterations);
 }
 
+TEST(Physics, PosesStartedFromTheCalibratedPosesAddedAreTheSameEquilibria) {
+  // The synthesis starts poses that combine muscles from superposed_pose.
+  Expected<FaceModel> m = model_1k({"zygomaticus_major_left", "risorius_left"});
+  ASSERT_TRUE(m.is_ok()) << m.status().message();
+  const int zyg = m->find("zygomaticus_major_left"), ris = m->find("risorius_left");
+  FactorCache cache;
+  // One muscle at +100 %: the guess is its calibrated pose, already in
+  // equilibrium.
+  Activation one;
+  one.muscles = {{zyg, 100.0}};
+  const Pose alone = superposed_pose(*m, one.muscles);
+  PoseOptions po;
+  po.start = &alone;
+  Expected<Pose> settled = solve_pose(*m, one, &cache, po);
+  ASSERT_TRUE(settled.is_ok()) << settled.status().message();
+  EXPECT_LE(settled->stats.iterations, 1);
+  EXPECT_LE((settled->X - alone.X).cwiseAbs().maxCoeff(), m->quantum);
+  // Both at 70 % and -60 %: the same equilibrium as from rest, in fewer
+  // iterations.
+  for (double pct : {70.0, -60.0}) {
+    Activation two;
+    two.muscles = {{zyg, pct}, {ris, pct}};
+    Expected<Pose> rest = solve_pose(*m, two, &cache);
+    const Pose guess = superposed_pose(*m, two.muscles);
+    po.start = &guess;
+    Expected<Pose> warm = solve_pose(*m, two, &cache, po);
+    ASSERT_TRUE(rest.is_ok() && warm.is_ok());
+    EXPECT_LE((pose_epidermis(*m, *warm) - pose_epidermis(*m, *rest)).cwiseAbs().maxCoeff(), m->quantum) << pct;
+    EXPECT_LT(warm->stats.iterations, rest->stats.iterations) << pct;
+    // Not the pose itself: the guess moves the corner further than the
+    // muscles together do, but not twice as far.
+    const int corner = m->fdps.find(*FdpId::parse("8.3"), m->skin)->vertex;
+    const double guessed = (guess.X.row(corner) - m->tissue.X0.row(corner)).norm();
+    const double solved = (rest->X.row(corner) - m->tissue.X0.row(corner)).norm();
+    EXPECT_GT(guessed, 0.5 * solved) << pct;
+    EXPECT_LT(guessed, 2.0 * solved) << pct;
+    std::printf("both at %+.0f %%: %d Newton iterations from rest, %d from the calibrated poses added; the mouth "
+                "corner moves %.4f, the guess %.4f\n",
+                pct, rest->stats.iterations, warm->stats.iterations, solved, guessed);
+  }
+}
+
 TEST(Physics, ResidualBelowToleranceAtTheEnd) {
   const FaceModel &m = head_1k().model;
   const int i = m.find("zygomaticus_major_left");
@@ -518,11 +568,7 @@ TEST(Physics, InvariantUnderTranslationAndScalesWithTheHead) {
 }
 
 TEST(Physics, DynamicSetEqualsWholeMeshWithinOneQuantum) {
-  const Built &b = head_1k();
-  FaceModelOptions fo;
-  fo.calibrate_only = {"zygomaticus_major_left"};
-  fo.calibrate_jaw = false;
-  Expected<FaceModel> m = build_face_model(b.head.scene, b.head.fdps, fo);
+  Expected<FaceModel> m = model_1k({"zygomaticus_major_left"});
   ASSERT_TRUE(m.is_ok()) << m.status().message();
   Activation a;
   a.muscles = {{m->find("zygomaticus_major_left"), 80.0}};
@@ -548,11 +594,7 @@ TEST(Physics, DynamicSetEqualsWholeMeshWithinOneQuantum) {
 }
 
 TEST(Calibration, FullContractionMovesTheKeyNodeByItsTarget) {
-  const Built &b = head_1k();
-  FaceModelOptions fo;
-  fo.calibrate_only = {"zygomaticus_major_left", "orbicularis_oris"};
-  fo.calibrate_jaw = false;
-  Expected<FaceModel> m = build_face_model(b.head.scene, b.head.fdps, fo);
+  Expected<FaceModel> m = model_1k({"zygomaticus_major_left", "orbicularis_oris"});
   ASSERT_TRUE(m.is_ok()) << m.status().message();
   for (const std::string name : {"zygomaticus_major_left", "orbicularis_oris"}) {
     const Muscle &mu = m->muscles[static_cast<size_t>(m->find(name))];
