@@ -151,6 +151,29 @@ Expected<std::vector<int>> wave_estimate(const FaceModel &model, const Muscle &m
   }
 }
 
+// X - reference on the nodes where they differ.
+NodeDisplacement displacement(const Eigen::MatrixXd &X, const Eigen::MatrixXd &reference) {
+  NodeDisplacement out;
+  for (Eigen::Index g = 0; g < X.rows(); ++g)
+    if (X.row(g) != reference.row(g)) out.nodes.push_back(static_cast<int>(g));
+  out.displacement.resize(static_cast<Eigen::Index>(out.nodes.size()), 3);
+  for (size_t i = 0; i < out.nodes.size(); ++i)
+    out.displacement.row(static_cast<Eigen::Index>(i)) = X.row(out.nodes[i]) - reference.row(out.nodes[i]);
+  return out;
+}
+
+// The rest state with the jaw's vertices (every layer) moved by `jaw`.
+Eigen::MatrixXd carried_rest(const FaceModel &model, const Eigen::Affine3d &jaw) {
+  const SkinModel &skin = model.tissue;
+  Eigen::MatrixXd X = skin.X0;
+  for (int v : model.jaw.vertices)
+    for (int l = 0; l < kTissueLayers; ++l) {
+      const int g = skin.node(l, v);
+      X.row(g) = (jaw * Eigen::Vector3d(skin.X0.row(g))).transpose();
+    }
+  return X;
+}
+
 // Finds the tension giving the +100 % (maximum) or -100 % action (section
 // 3.3): one equilibrium solve with the tension as an unknown (solver.h, load
 // control), on `set`, grown while the wave reaches its border.
@@ -175,13 +198,7 @@ Status calibrate_side(const FaceModel &model, Muscle &m, bool maximum, FactorCac
                   " model units) was not found");
   if (torn) *torn = skin_faults(model, X.topRows(model.tissue.n)).tears();
   (maximum ? m.tension_max : m.tension_min) = control.tension;
-  Muscle::Response &r = maximum ? m.response_max : m.response_min;
-  r.nodes.clear();
-  for (Eigen::Index g = 0; g < X.rows(); ++g)
-    if (X.row(g) != model.tissue.X0.row(g)) r.nodes.push_back(static_cast<int>(g));
-  r.displacement.resize(static_cast<Eigen::Index>(r.nodes.size()), 3);
-  for (size_t i = 0; i < r.nodes.size(); ++i)
-    r.displacement.row(static_cast<Eigen::Index>(i)) = X.row(r.nodes[i]) - model.tissue.X0.row(r.nodes[i]);
+  (maximum ? m.response_max : m.response_min) = displacement(X, model.tissue.X0);
   return Status::ok();
 }
 
@@ -342,6 +359,7 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
   if (!options.calibrate_jaw) return model;
   if (!jaw_pose) return jaw_pose.status().wrap("jaw");
   model.jaw.dynamic = jaw_pose->dynamic;
+  model.jaw.open_response = displacement(jaw_pose->X, carried_rest(model, jaw_pose->jaw));
   return model;
 }
 
@@ -417,11 +435,7 @@ Expected<Pose> solve_pose(const FaceModel &model, const Activation &a, FactorCac
   if (jaw_moves) {
     if (a.jaw_open < 0) return Status::error("pose: the jaw does not open by a negative amount");
     pose.jaw = jaw_motion(model.jaw, a.jaw_open, a.jaw_thrust, a.jaw_shift);
-    for (int v : model.jaw.vertices)
-      for (int l = 0; l < kTissueLayers; ++l) {
-        const int g = skin.node(l, v);
-        pose.X.row(g) = (pose.jaw * Eigen::Vector3d(skin.X0.row(g))).transpose();
-      }
+    pose.X = carried_rest(model, pose.jaw);
     join(model.jaw.dynamic.empty() ? model.jaw.vertices : model.jaw.dynamic);
   }
   const Eigen::MatrixXd reference = pose.X;  // the rest state, carried by the jaw
@@ -454,19 +468,23 @@ Eigen::MatrixXd pose_epidermis(const FaceModel &model, const Pose &pose) {
   return pose.X.topRows(model.tissue.n);
 }
 
-Pose superposed_pose(const FaceModel &model, const std::vector<std::pair<int, double>> &muscles) {
+Pose superposed_pose(const FaceModel &model, const Activation &a) {
   Pose out;
-  out.X = model.tissue.X0;
-  for (const auto &[i, pct] : muscles) {
+  auto add = [&out](const NodeDisplacement &r, double share, const std::vector<int> &set) {
+    for (size_t k = 0; k < r.nodes.size(); ++k)
+      out.X.row(r.nodes[k]) += share * r.displacement.row(static_cast<Eigen::Index>(k));
+    std::vector<int> u;
+    std::set_union(out.dynamic.begin(), out.dynamic.end(), set.begin(), set.end(), std::back_inserter(u));
+    out.dynamic = std::move(u);
+  };
+  const bool jaw_moves = a.jaw_open != 0 || a.jaw_thrust != 0 || a.jaw_shift != 0;
+  if (jaw_moves) out.jaw = jaw_motion(model.jaw, a.jaw_open, a.jaw_thrust, a.jaw_shift);
+  out.X = jaw_moves ? carried_rest(model, out.jaw) : model.tissue.X0;
+  if (jaw_moves) add(model.jaw.open_response, std::max(a.jaw_open, 0.0) / 100, model.jaw.dynamic);
+  for (const auto &[i, pct] : a.muscles) {
     if (i < 0 || i >= static_cast<int>(model.muscles.size()) || pct == 0) continue;
     const Muscle &m = model.muscles[static_cast<size_t>(i)];
-    const Muscle::Response &r = pct > 0 ? m.response_max : m.response_min;
-    for (size_t k = 0; k < r.nodes.size(); ++k)
-      out.X.row(r.nodes[k]) += std::abs(pct) / 100 * r.displacement.row(static_cast<Eigen::Index>(k));
-    const std::vector<int> &own = m.dynamic.empty() ? m.influence : m.dynamic;
-    std::vector<int> u;
-    std::set_union(out.dynamic.begin(), out.dynamic.end(), own.begin(), own.end(), std::back_inserter(u));
-    out.dynamic = std::move(u);
+    add(pct > 0 ? m.response_max : m.response_min, std::abs(pct) / 100, m.dynamic.empty() ? m.influence : m.dynamic);
   }
   return out;
 }

@@ -152,15 +152,17 @@ Expected<Pose> solve_pose_to(const FaceModel &model, const std::vector<std::pair
 // The epidermis of a pose, #V x 3 (the skin part's vertex positions).
 Eigen::MatrixXd pose_epidermis(const FaceModel &model, const Pose &pose);
 
-// A first guess, not an equilibrium: the muscles' calibrated poses
-// (Muscle::response_max or _min) scaled by |percent| / 100 and added, on the
-// union of their dynamic sets, the jaw at rest. As PoseOptions::start or
+// A first guess, not an equilibrium: the rest carried by the jaw's motion,
+// plus its calibrated full opening (Jaw::open_response) scaled by the
+// opening / 100, plus the muscles' calibrated poses (Muscle::response_max or
+// _min) scaled by |percent| / 100, on the union of their dynamic sets. (Thrust
+// and shift have no calibrated pose: the carried rest.) As PoseOptions::start or
 // SteerFrom::pose it halves the Newton iterations of a pose that combines
 // muscles (Song's visemes and expressions: 54 iterations against 109 from
 // rest, the same equilibria within the tolerance for 10 of 12). The tissue is
 // not linear, so the guess is not the pose: muscles contracted together
 // move the skin less than the sum.
-Pose superposed_pose(const FaceModel &model, const std::vector<std::pair<int, double>> &muscles);
+Pose superposed_pose(const FaceModel &model, const Activation &activation);
 
 // What is wrong with an epidermis E (#V x 3, model units) as a face: skin
 // triangles whose normal turned against its rest one (slivers under a

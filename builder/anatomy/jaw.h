@@ -52,6 +52,9 @@ struct Jaw {
   double max_thrust = 0, max_shift = 0;  // model units at 100 %
   double open_glide = 0;            // forward translation at 100 % opening, model units
   std::vector<int> dynamic;         // V_d of a full opening, sorted
+  // The calibrated pose of a full opening, from the rest carried by the
+  // jaw (face_model.h: a first guess for poses that open it).
+  NodeDisplacement open_response;
 };
 
 // FDPs the jaw needs: 2.1-2.5, 2.8, 2.9, 2.11-2.14, 5.3, 5.4. Fails naming

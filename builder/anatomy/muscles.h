@@ -66,14 +66,9 @@ struct Muscle {
   // got there (a non-essential muscle; the model's warnings say so).
   double range_max = 1, range_min = 1;
   std::vector<int> dynamic;     // V_d: vertices the elastic wave moves, sorted
-  // The calibrated poses at +100 % and -100 %: the displacement from rest of
-  // every node they move (global node index, model units). First guesses
-  // for poses that combine muscles (face_model.h, superposed_pose).
-  struct Response {
-    std::vector<int> nodes;       // ascending
-    Eigen::MatrixXd displacement; // #nodes x 3
-  };
-  Response response_max, response_min;
+  // The calibrated poses at +100 % and -100 %, from rest. First guesses for
+  // poses that combine muscles (face_model.h, superposed_pose).
+  NodeDisplacement response_max, response_min;
 };
 
 // Places one muscle of the table: evaluates its key points, maps them to the

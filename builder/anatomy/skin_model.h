@@ -85,6 +85,13 @@ struct EyeSphere {
   double radius = 0;
 };
 
+// A pose's displacement on the nodes it moves: global node indices into
+// SkinModel::X0, ascending, and their displacement (#nodes x 3, model units).
+struct NodeDisplacement {
+  std::vector<int> nodes;
+  Eigen::MatrixXd displacement;
+};
+
 struct SkinModel {
   int part = -1;           // the scene part the skin is
   int n = 0;               // nodes per surface (= the skin part's vertex count)

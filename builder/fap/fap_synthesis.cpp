@@ -243,7 +243,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         for (size_t k = 0; k < b.muscles.size(); ++k)
           if (reduced[k]) b.muscles[k].second *= share;
         if (reduced.back()) b.jaw_open *= share;
-        const Pose guess = from ? Pose() : superposed_pose(model, b.muscles);
+        const Pose guess = from ? Pose() : superposed_pose(model, b);
         PoseOptions po;
         po.start = from ? from : &guess;
         return solve_pose(model, b, &cache, po);
@@ -365,11 +365,12 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         // tissue, a few percent short or beyond. So: the bone's motion at
         // the FDP first, then secant steps on the solved pose. Each round
         // starts from the pose of the largest motion solved so far that does
-        // not pass its own, as the jaw loads the tissue, else from rest: a few
-        // Newton iterations instead of a solve from rest, and the rounds stay
-        // on one branch where the tissue snaps through (at Song's chin the
-        // midline buckles at 20 % open; rounds from rest landed on either side
-        // and the secant did not converge).
+        // not pass its own, as the jaw loads the tissue (the first from the
+        // calibrated opening scaled, superposed_pose): a few Newton
+        // iterations instead of a solve from rest, and the rounds stay on one
+        // branch where the tissue snaps through (at Song's chin the midline
+        // buckles at 20 % open; rounds from rest landed on either side and the
+        // secant did not converge).
         double pct = jaw_percent(model.jaw, map->driver, p, side * dir, value);
         FactorCache cache;
         Expected<Pose> pz = Status::error("no pose");
@@ -385,6 +386,8 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
           double from = -1;
           for (const auto &[at, q] : solved)
             if (at <= std::abs(pct) && at > from) po.start = &q, from = at;
+          const Pose guess = po.start ? Pose() : superposed_pose(model, a);
+          if (!po.start) po.start = &guess;
           pz = solve_pose(model, a, &cache, po);
           if (!pz) break;
           const double along = (pz->X.row(fdp->vertex) - skin.X0.row(fdp->vertex)).dot(side * dir.transpose());
@@ -454,7 +457,9 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         // The first guess: the muscles' calibrated poses added, scaled by the
         // share that would bring the FDP to the value if the tissue were
         // linear (within the range).
-        const Pose sum = superposed_pose(model, pattern);
+        Activation group;
+        group.muscles = pattern;
+        const Pose sum = superposed_pose(model, group);
         const double sum_action = action(sum.X, nullptr);
         Pose guess = sum;
         SteerFrom first;

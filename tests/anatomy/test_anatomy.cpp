@@ -477,29 +477,36 @@ TEST(Physics, APoseStartedFromANearbyOneIsTheSameEquilibrium) {
 }
 
 TEST(Physics, PosesStartedFromTheCalibratedPosesAddedAreTheSameEquilibria) {
-  // The synthesis starts poses that combine muscles from superposed_pose.
-  Expected<FaceModel> m = model_1k({"zygomaticus_major_left", "risorius_left"});
+  // The synthesis starts poses that combine muscles and the jaw from
+  // superposed_pose.
+  FaceModelOptions fo;
+  fo.calibrate_only = {"zygomaticus_major_left", "risorius_left"};
+  Expected<FaceModel> m = build_face_model(head_1k().head.scene, head_1k().head.fdps, fo);
   ASSERT_TRUE(m.is_ok()) << m.status().message();
   const int zyg = m->find("zygomaticus_major_left"), ris = m->find("risorius_left");
   FactorCache cache;
-  // One muscle at +100 %: the guess is its calibrated pose, already in
-  // equilibrium.
-  Activation one;
+  // One muscle at +100 %, or the jaw fully open: the guess is the
+  // calibrated pose, already in equilibrium.
+  Activation one, open;
   one.muscles = {{zyg, 100.0}};
-  const Pose alone = superposed_pose(*m, one.muscles);
+  open.jaw_open = 100;
   PoseOptions po;
-  po.start = &alone;
-  Expected<Pose> settled = solve_pose(*m, one, &cache, po);
-  ASSERT_TRUE(settled.is_ok()) << settled.status().message();
-  EXPECT_LE(settled->stats.iterations, 1);
-  EXPECT_LE((settled->X - alone.X).cwiseAbs().maxCoeff(), m->quantum);
-  // Both at 70 % and -60 %: the same equilibrium as from rest, in fewer
-  // iterations.
-  for (double pct : {70.0, -60.0}) {
+  for (const Activation &a : {one, open}) {
+    const Pose alone = superposed_pose(*m, a);
+    po.start = &alone;
+    Expected<Pose> settled = solve_pose(*m, a, &cache, po);
+    ASSERT_TRUE(settled.is_ok()) << settled.status().message();
+    EXPECT_LE(settled->stats.iterations, 1);
+    EXPECT_LE((settled->X - alone.X).cwiseAbs().maxCoeff(), m->quantum);
+  }
+  // Both at 70 % and -60 %, and both at 50 % with the jaw open 40 %: the same
+  // equilibrium as from rest, in fewer iterations.
+  for (double pct : {70.0, -60.0, 50.0}) {
     Activation two;
     two.muscles = {{zyg, pct}, {ris, pct}};
+    if (pct == 50) two.jaw_open = 40;
     Expected<Pose> rest = solve_pose(*m, two, &cache);
-    const Pose guess = superposed_pose(*m, two.muscles);
+    const Pose guess = superposed_pose(*m, two);
     po.start = &guess;
     Expected<Pose> warm = solve_pose(*m, two, &cache, po);
     ASSERT_TRUE(rest.is_ok() && warm.is_ok());
@@ -512,9 +519,9 @@ TEST(Physics, PosesStartedFromTheCalibratedPosesAddedAreTheSameEquilibria) {
     const double solved = (rest->X.row(corner) - m->tissue.X0.row(corner)).norm();
     EXPECT_GT(guessed, 0.5 * solved) << pct;
     EXPECT_LT(guessed, 2.0 * solved) << pct;
-    std::printf("both at %+.0f %%: %d Newton iterations from rest, %d from the calibrated poses added; the mouth "
-                "corner moves %.4f, the guess %.4f\n",
-                pct, rest->stats.iterations, warm->stats.iterations, solved, guessed);
+    std::printf("both at %+.0f %%, the jaw open %.0f %%: %d Newton iterations from rest, %d from the calibrated poses "
+                "added; the mouth corner moves %.4f, the guess %.4f\n",
+                pct, two.jaw_open, rest->stats.iterations, warm->stats.iterations, solved, guessed);
   }
 }
 
