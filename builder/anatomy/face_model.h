@@ -106,7 +106,7 @@ struct PoseOptions {
   // its dynamic set joins this one's.
   // A nearby activation then takes a few Newton iterations instead of a solve
   // from rest, and follows the same branch where the tissue has two
-  // equilibria (the skull and eyeball contacts). Null: from rest.
+  // equilibria (Song's chin snaps through as the jaw opens). Null: from rest.
   const Pose *start = nullptr;
 };
 
@@ -160,8 +160,8 @@ Eigen::MatrixXd pose_epidermis(const FaceModel &model, const Pose &pose);
 // SteerFrom::pose it halves the Newton iterations of a pose that combines
 // muscles (Song's visemes and expressions: 54 iterations against 109 from
 // rest, the same equilibria within the tolerance for 10 of 12). The tissue is
-// not linear, so the guess is not the pose: muscles contracted together
-// move the skin less than the sum.
+// not linear, so the guess is not the pose: two mouth muscles together move
+// the 1k head's mouth corner up to a fifth more or less than the sum.
 Pose superposed_pose(const FaceModel &model, const Activation &activation);
 
 // What is wrong with an epidermis E (#V x 3, model units) as a face: skin

@@ -236,7 +236,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       // `reduced` marks the muscles (one per a.muscles entry, then the jaw)
       // that `share` scales; the others keep the table's contraction.
       // Each solve starts from `from` (a pose of a smaller share of the same
-      // muscles), else from the muscles' calibrated poses added
+      // muscles), else from the muscles' and the jaw's calibrated poses added
       // (superposed_pose): half the Newton iterations of a start from rest.
       auto solve_share = [&](const std::vector<char> &reduced, double share, const Pose *from = nullptr) {
         Activation b = a;
