@@ -764,6 +764,8 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
   };
   const int max_it = options.max_iterations > 0 ? options.max_iterations : 400;
   double action = 0;
+  int projected_run = 0;  // refreshes in a row that did not factorise the full tangent
+  double shift = 1e-3;    // the last diagonal shift that made the full tangent definite
   for (int it = 0;; ++it) {
     const ForceField load = load_at(t);
     net_force(sys, load, reference, X, r);
@@ -792,10 +794,40 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     // The full tangent while it is definite: Newton then converges
     // quadratically near the equilibrium. Where it is not (compressed
     // springs, strongly deformed elements), the projected one (linearise()).
+    // Newton on the projected tangent converges linearly, and where the full
+    // one stays indefinite to the end it crawls: a calibration of the 10k
+    // head's mentalis took 134 iterations, the last 120 moving about twice
+    // the tolerance each. So after two refreshes in a row on the projected
+    // tangent, the full one with its diagonal raised by a factor 1 + mu is
+    // tried first (mu from the last that worked, 1e-3 at first, then ten
+    // and a hundred times that, at most 0.1): a Levenberg-Marquardt step
+    // that keeps the curvature of the compressed springs and of the volume
+    // term. The 10k head's model: 451 -> 341 Newton iterations; Song's AFM
+    // 1,424 -> 1,362; the same models and reports.
     bool full = true;
     auto project = [&] {
       linearise(sys, X, K, diag, full = false);
       add_load_stiffness(sys, load, X, K, diag);
+    };
+    auto shifted = [&] {
+      const SpMat unshifted = K;
+      for (double mu : {shift, 10 * shift, 100 * shift}) {
+        if (mu > 0.1) break;
+        K = unshifted;
+        for (Eigen::Index c = 0; c < K.outerSize(); ++c)
+          for (SpMat::InnerIterator e(K, c); e; ++e)
+            if (e.row() == e.col()) e.valueRef() *= 1 + mu;
+        Kf = K;
+        contacts.filter(sys, Kf);
+        ++st.factorisations;
+        if (entry->symbolic.factorize(Kf) == Ldlt::Result::kDefinite) {
+          shift = mu;
+          full = false;
+          return true;
+        }
+      }
+      K = unshifted;
+      return false;
     };
     auto factorise = [&] {
       for (;;) {
@@ -806,6 +838,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
         const bool ok = res != Ldlt::Result::kSingular;
         if (ok && (!full || res == Ldlt::Result::kDefinite)) break;
         if (!full) return false;
+        if (projected_run >= 2 && shifted()) break;
         project();
       }
       factor = &entry->symbolic;
@@ -821,6 +854,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     };
     bool fresh = refresh;
     if (refresh && !factorise()) return done(false, name + ": the tangent stiffness is singular");
+    if (refresh) projected_run = full ? 0 : projected_run + 1;
     refresh = false;
     // newton: CG past a factorisation's worth of iterations (a stale
     // factorisation, say a projected one before a full tangent) stops, and

@@ -24,7 +24,9 @@
 //             second-order part, and is positive semi-definite everywhere.
 //             The solvers use the full tangent where it is definite and the
 //             projected one where it is not (implicit-euler: always the
-//             projected one);
+//             projected one); the newton solvers, after two projected
+//             refreshes in a row, the full one with its diagonal raised by
+//             1 + mu first (mu 1e-3 to 0.1) where that is definite;
 //   muscles   the ForceField, a conservative load, with its Hessian;
 //   skull     non-penetration as a constraint: a node below the plane of
 //             its skull node (normal: the vertex's rest normal) is put back
