@@ -151,6 +151,13 @@ Expected<std::vector<int>> wave_estimate(const FaceModel &model, const Muscle &m
   }
 }
 
+// set |= more (both sorted, unique).
+void join(std::vector<int> &set, const std::vector<int> &more) {
+  std::vector<int> u;
+  std::set_union(set.begin(), set.end(), more.begin(), more.end(), std::back_inserter(u));
+  set = std::move(u);
+}
+
 // X - reference on the nodes where they differ.
 NodeDisplacement displacement(const Eigen::MatrixXd &X, const Eigen::MatrixXd &reference) {
   NodeDisplacement out;
@@ -390,10 +397,7 @@ Status muscle_set(const FaceModel &model, const std::vector<std::pair<int, doubl
     const Muscle &m = model.muscles[static_cast<size_t>(i)];
     if (pct != 0 && !(pct > 0 ? m.tension_max > 0 : m.tension_min > 0))
       return Status::error("pose: muscle " + m.name + " is not calibrated");
-    const std::vector<int> &own = m.dynamic.empty() ? m.influence : m.dynamic;
-    std::vector<int> u;
-    std::set_union(set.begin(), set.end(), own.begin(), own.end(), std::back_inserter(u));
-    set = std::move(u);
+    join(set, m.dynamic.empty() ? m.influence : m.dynamic);
   }
   return Status::ok();
 }
@@ -416,10 +420,7 @@ Expected<Pose> solve_pose_to(const FaceModel &model, const std::vector<std::pair
   SolverOptions opts = model.solver;
   if (from && from->pose) {
     pose.X = from->pose->X;
-    std::vector<int> u;
-    std::set_union(set.begin(), set.end(), from->pose->dynamic.begin(), from->pose->dynamic.end(),
-                   std::back_inserter(u));
-    set = std::move(u);
+    join(set, from->pose->dynamic);
     control.tension = from->scale;
   }
   if (from && from->max_iterations > 0) opts.max_iterations = from->max_iterations;
@@ -441,22 +442,17 @@ Expected<Pose> solve_pose(const FaceModel &model, const Activation &a, FactorCac
   std::vector<int> set;
   if (Status s = muscle_set(model, a.muscles, set); !s) return s;
   const bool jaw_moves = a.jaw_open != 0 || a.jaw_thrust != 0 || a.jaw_shift != 0;
-  auto join = [&set](const std::vector<int> &more) {
-    std::vector<int> u;
-    std::set_union(set.begin(), set.end(), more.begin(), more.end(), std::back_inserter(u));
-    set = std::move(u);
-  };
   if (jaw_moves) {
     if (a.jaw_open < 0) return Status::error("pose: the jaw does not open by a negative amount");
     pose.jaw = jaw_motion(model.jaw, a.jaw_open, a.jaw_thrust, a.jaw_shift);
     pose.X = carried_rest(model, pose.jaw);
-    join(model.jaw.dynamic.empty() ? model.jaw.vertices : model.jaw.dynamic);
+    join(set, model.jaw.dynamic.empty() ? model.jaw.vertices : model.jaw.dynamic);
   }
   const Eigen::MatrixXd reference = pose.X;  // the rest state, carried by the jaw
   if (const Pose *from = options.start) {
     // Its free nodes as the first guess; the skull nodes (fixed) stay this
     // pose's own, exactly.
-    join(from->dynamic);
+    join(set, from->dynamic);
     const Eigen::Affine3d carry = pose.jaw * from->jaw.inverse();
     std::vector<char> on_jaw(static_cast<size_t>(skin.n), 0);
     for (int v : model.jaw.vertices) on_jaw[static_cast<size_t>(v)] = 1;
@@ -487,9 +483,7 @@ Pose superposed_pose(const FaceModel &model, const Activation &a) {
   auto add = [&out](const NodeDisplacement &r, double share, const std::vector<int> &set) {
     for (size_t k = 0; k < r.nodes.size(); ++k)
       out.X.row(r.nodes[k]) += share * r.displacement.row(static_cast<Eigen::Index>(k));
-    std::vector<int> u;
-    std::set_union(out.dynamic.begin(), out.dynamic.end(), set.begin(), set.end(), std::back_inserter(u));
-    out.dynamic = std::move(u);
+    join(out.dynamic, set);
   };
   const bool jaw_moves = a.jaw_open != 0 || a.jaw_thrust != 0 || a.jaw_shift != 0;
   if (jaw_moves) out.jaw = jaw_motion(model.jaw, a.jaw_open, a.jaw_thrust, a.jaw_shift);
