@@ -1,27 +1,31 @@
 // AFM size at equal error and decode time, on real anatomical targets
-// (issue 5): the builder's model and FAP synthesis, as afm-build -o runs them.
+// (issue 5): the builder's model and FAP synthesis, as afm-build -o runs them
+// (on the simulation mesh, its motion stored on control points: LIFT).
 //
 // Models: the reference head at 2,000 skin vertices and the Song head when
-// ../shared/data is there; their builds take about 1 and 6.5 minutes on one
-// core (a worker per core by default). The 10k head (about 7 minutes) is
-// left out by default; `--vertices 10000` adds it.
+// ../shared/data is there; their builds take about 10 and 15 seconds on two
+// workers (a worker per core by default). The 10k head is left out by
+// default; `--vertices 10000` adds it.
 //
 // Per model:
-// - sizes: the AFM file and its MTGT chunk, raw and draco profiles, against
-//   dense float32 targets (targets x vertices x 3 x 4 bytes over every AFM
-//   vertex, seam copies included; normal deltas counted too when the AFM
-//   stores them) and against a meshopt-style baseline at equal error:
-//     the AFM's own quanta (the same grid, hence the same error), each target
-//     dense over every vertex in the AFM's vertex order; per component the
-//     int16 delta from the previous vertex, zigzagged, split into a low and a
-//     high byte plane (meshoptimizer's vertex codec deltas and zigzags each
-//     byte lane; whole int16 deltas are the kinder choice on smooth fields);
-//     every target's planes then in one zlib stream at level 9, where
-//     meshoptimizer would be followed by a general compressor. No
-//     meshoptimizer code. The baseline is decoded back and must give the
-//     AFM's quanta exactly.
+// - sizes: the AFM file and its targets (the MTGT chunk plus LIFT when the
+//   AFM has control points), raw and draco profiles, against dense float32
+//   targets (targets x vertices x 3 x 4 bytes over every AFM vertex, seam
+//   copies included; normal deltas counted too when the AFM stores them) and
+//   against a meshopt-style baseline at equal error:
+//     the builder's targets rounded to whole quanta of the AFM's grid per
+//     vertex (the AFM's own lifted deltas rounded when measuring a file),
+//     each target dense over every vertex in the AFM's vertex order; per
+//     component the int16 delta from the previous vertex, zigzagged, split
+//     into a low and a high byte plane (meshoptimizer's vertex codec deltas
+//     and zigzags each byte lane; whole int16 deltas are the kinder choice on
+//     smooth fields); every target's planes then in one zlib stream at level
+//     9, where meshoptimizer would be followed by a general compressor. No
+//     meshoptimizer code. The baseline is decoded back and must give its
+//     quanta exactly.
 // - error: every target decoded with the format library to dense float
-//   displacements, against the builder's double targets on the same render
+//   displacements (control points lifted exactly, afm_target_expand), and
+//   the baseline's, against the builder's double targets on the same render
 //   vertices; the largest component error in grid quanta (0.5 is rounding).
 // - times: reading the AFM from memory into a ready player (afm_doc_read_alloc,
 //   afm_player_init), raw and draco; a pose per frame over a cycle of states
@@ -50,6 +54,7 @@
 
 #include "afm/afm_export.h"
 #include "anatomy/face_model.h"
+#include "anatomy/sim_mesh.h"
 #include "fap/fap_synthesis.h"
 #include "io/load_face.h"
 #include "refhead/refhead.h"
@@ -79,9 +84,9 @@ struct Input {
 
 // encode_afm's own vertex order and seam split, so entry r of a target is
 // what the AFM's vertex r should hold.
-std::vector<std::vector<double>> builder_targets(const Scene &scene, const std::vector<MorphTarget> &targets) {
-  const std::vector<std::vector<int>> order = run_friendly_order(scene, targets, afm_position_quantum(scene));
-  const RenderVertices rv = split_render_vertices(scene, &order);
+std::vector<std::vector<double>> builder_targets(const AfmContent &content) {
+  const RenderVertices rv = afm_render_vertices(content);
+  const std::vector<MorphTarget> &targets = content.targets;
   std::vector<std::vector<double>> out(targets.size(), std::vector<double>(3 * rv.count, 0.0));
   for (size_t t = 0; t < targets.size(); ++t)
     for (size_t p = 0; p < targets[t].displacement.size(); ++p) {
@@ -106,20 +111,23 @@ Input build(const std::string &name, const Scene &scene, const FdpSet &fdps, int
   FaceModelOptions fo;
   fo.threads = threads;
   fo.progress = [](int d, int n, const std::string &w) { progress("model  ", d, n, w); };
-  Expected<FaceModel> model = build_face_model(scene, fdps, fo);
+  // As afm-build makes it: on the simulation mesh, targets carried to the skin.
+  Expected<SimFaceModel> model = build_sim_face_model(scene, fdps, SimMeshOptions{kDefaultSimVertices}, fo);
   if (!model) die(name + ": " + model.status().message());
   const double t_model = since(t0);
   FapSynthesisOptions so;
   so.threads = threads;
   so.progress = [](int d, int n, const std::string &w) { progress("targets", d, n, w); };
-  Expected<FapSynthesis> syn = synthesize_faps(scene, *model, so);
+  Expected<FapSynthesis> syn = synthesize_faps(model->scene, model->model, so);
   if (!syn) die(name + ": " + syn.status().message());
-  AfmContent content = fap_afm_content(scene, fdps, *model, std::move(*syn));
+  lift_synthesis(*syn, model->sim);
+  AfmContent content = fap_afm_content(scene, fdps, model->model, std::move(*syn));
   Expected<std::vector<uint8_t>> raw = encode_afm(content, AFM_PROFILE_RAW);
   if (!raw) die(name + ": " + raw.status().message());
   const double t_all = since(t0);
-  std::printf("   built in %.1f s (model %.1f s, targets and AFM %.1f s)\n", t_all, t_model, t_all - t_model);
-  return {name, std::move(*raw), builder_targets(scene, content.targets)};
+  std::printf("   built in %.1f s (model %.1f s on %zu simulation vertices, targets and AFM %.1f s)\n", t_all,
+              t_model, static_cast<size_t>(model->sim.V.rows()), t_all - t_model);
+  return {name, std::move(*raw), builder_targets(content)};
 }
 
 std::vector<uint8_t> transcode(const std::vector<uint8_t> &bytes, afm_profile profile) {
@@ -144,19 +152,38 @@ afm_doc *read_doc(const std::vector<uint8_t> &bytes) {
 // Components a target stores per vertex: positions, and normals when it has them.
 int components(const afm_target &t) { return t.nx ? 6 : 3; }
 
-// Every target dense over all vertices, in quanta (x y z [nx ny nz] per vertex).
-std::vector<std::vector<int16_t>> dense_quanta(const afm_doc &doc) {
+// Every target dense over all vertices as the AFM defines it (control
+// points lifted), in Q15 quanta: x y z per vertex.
+std::vector<std::vector<int32_t>> dense_q15(const afm_doc &doc) {
+  const size_t V = doc.geometry.vertex_count;
+  std::vector<std::vector<int32_t>> out(doc.target_count);
+  std::vector<int32_t> all(3 * static_cast<size_t>(afm_doc_entry_count(&doc)));
+  for (uint32_t t = 0; t < doc.target_count; ++t) {
+    if (afm_target_expand(&doc, &doc.targets[t], all.data()) != AFM_OK) die("afm_target_expand");
+    out[t].assign(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(3 * V));
+  }
+  return out;
+}
+
+// Every target dense over all vertices in whole quanta, as a per-vertex
+// quantised store holds it (x y z [nx ny nz] per vertex): the lifted deltas
+// rounded, normal deltas as stored.
+std::vector<std::vector<int16_t>> dense_quanta(const afm_doc &doc, const std::vector<std::vector<int32_t>> &q15) {
   const size_t V = doc.geometry.vertex_count;
   std::vector<std::vector<int16_t>> out(doc.target_count);
   for (uint32_t t = 0; t < doc.target_count; ++t) {
     const afm_target &tg = doc.targets[t];
     const size_t c = static_cast<size_t>(components(tg));
-    const int16_t *src[6] = {tg.dx, tg.dy, tg.dz, tg.nx, tg.ny, tg.nz};
     out[t].assign(c * V, 0);
+    for (size_t v = 0; v < V; ++v)
+      for (size_t j = 0; j < 3; ++j)
+        out[t][c * v + j] = static_cast<int16_t>(std::lround(q15[t][3 * v + j] / 32768.0));
+    if (c == 3) continue;
+    const int16_t *src[3] = {tg.nx, tg.ny, tg.nz};
     uint32_t k = 0;
     for (uint32_t r = 0; r < tg.run_count; ++r)
       for (uint32_t i = 0; i < tg.runs[r].length; ++i, ++k)
-        for (size_t j = 0; j < c; ++j) out[t][c * (tg.runs[r].start + i) + j] = src[j][k];
+        for (size_t j = 0; j < 3; ++j) out[t][c * (tg.runs[r].start + i) + 3 + j] = src[j][k];
   }
   return out;
 }
@@ -219,8 +246,22 @@ size_t baseline_bytes(const std::vector<std::vector<int16_t>> &dense, size_t V) 
 }
 
 // Positions of every target dense in model units (x y z per vertex): what
-// a dense float32 store would hold.
-std::vector<std::vector<float>> dense_floats(const afm_doc &doc, const std::vector<std::vector<int16_t>> &dense) {
+// a dense float32 store of the AFM's targets would hold.
+std::vector<std::vector<float>> dense_floats(const afm_doc &doc, const std::vector<std::vector<int32_t>> &q15) {
+  std::vector<std::vector<float>> out(q15.size());
+  for (size_t t = 0; t < q15.size(); ++t)
+    for (int32_t q : q15[t]) out[t].push_back(static_cast<float>(q / 32768.0 * double(doc.geometry.step)));
+  return out;
+}
+
+bool with_normals_any(const afm_doc &doc) {
+  for (uint32_t t = 0; t < doc.target_count; ++t)
+    if (doc.targets[t].nx) return true;
+  return false;
+}
+
+// The same from whole quanta (the baseline's values).
+std::vector<std::vector<float>> quanta_floats(const afm_doc &doc, const std::vector<std::vector<int16_t>> &dense) {
   const size_t V = doc.geometry.vertex_count;
   std::vector<std::vector<float>> out(dense.size(), std::vector<float>(3 * V));
   for (size_t t = 0; t < dense.size(); ++t) {
@@ -318,36 +359,48 @@ void measure(const Input &in) {
   afm_doc *doc = read_doc(raw);
   const size_t V = doc->geometry.vertex_count, T = doc->target_count;
   if (!T) die(in.name + ": no morph targets");
-  const std::vector<std::vector<int16_t>> dense = dense_quanta(*doc);
+  const std::vector<std::vector<int32_t>> q15 = dense_q15(*doc);
+  // The baseline's quanta: the builder's own targets rounded per vertex when
+  // built here (the same half-quantum error as the AFM's), else the AFM's.
+  std::vector<std::vector<int16_t>> dense = dense_quanta(*doc, q15);
+  if (in.exact.size() == T && !with_normals_any(*doc))
+    for (size_t t = 0; t < T; ++t)
+      for (size_t i = 0; i < 3 * V; ++i)
+        dense[t][i] = static_cast<int16_t>(std::lround(in.exact[t][i] / double(doc->geometry.step)));
   size_t with_normals = 0;
   for (size_t t = 0; t < T; ++t) with_normals += components(doc->targets[t]) == 6;
   const size_t dense_bytes = (T + with_normals) * V * 3 * 4;
   const size_t base_bytes = baseline_bytes(dense, V);
-  const std::vector<std::vector<float>> dense_f = dense_floats(*doc, dense);
+  const std::vector<std::vector<float>> dense_f = dense_floats(*doc, q15);
   const double err = max_error_quanta(*doc, dense_f, in.exact);
+  const double base_err = max_error_quanta(*doc, quanta_floats(*doc, dense), in.exact);
 
   const std::string units = *doc->meta.units ? std::string(" ") + doc->meta.units : " model units";
   std::printf("-- %s: %zu targets, %zu vertices, grid step %.3g%s; ", in.name.c_str(), T, V,
               static_cast<double>(doc->geometry.step), units.c_str());
   if (with_normals) std::printf("%zu targets store normal deltas (dense float counts them)\n", with_normals);
   else std::printf("no normal deltas stored (dense float counts positions only)\n");
+  if (doc->lift)
+    std::printf("   control points (LIFT): %u controls drive %u vertices; the targets move the controls\n",
+                doc->lift->control_count, doc->lift->bound_count);
   std::printf("   %-16s %11s %11s %13s %11s %16s\n", "", "targets B", "file B", "dense/targets", "dense/file",
               "baseline/targets");
   for (int d = 0; d < 2; ++d) {
     const std::vector<uint8_t> &f = d ? draco : raw;
-    const size_t m = chunk_bytes(f, AFM_CHUNK_MTGT);
+    // What the targets take: MTGT, and LIFT when there is one.
+    const size_t m = chunk_bytes(f, AFM_CHUNK_MTGT) + chunk_bytes(f, AFM_CHUNK_LIFT);
     std::printf("   %-16s %11zu %11zu %12.1fx %10.1fx %15.2fx\n", d ? "AFM draco" : "AFM raw", m, f.size(),
                 double(dense_bytes) / double(m), double(dense_bytes) / double(f.size()),
                 double(base_bytes) / double(m));
   }
   std::printf("   %-16s %11zu\n   %-16s %11zu\n", "dense float32", dense_bytes, "baseline (zlib)", base_bytes);
   if (err >= 0)
-    std::printf("   max error against the builder's float targets: %.3f quanta (%.3g%s), AFM and baseline alike "
-                "(the baseline decodes to the AFM's quanta exactly)\n",
-                err, err * static_cast<double>(doc->geometry.step), units.c_str());
+    std::printf("   max error against the builder's float targets: AFM %.3f quanta (%.3g%s), baseline %.3f quanta "
+                "(the builder's targets rounded to whole quanta per vertex)\n",
+                err, err * static_cast<double>(doc->geometry.step), units.c_str(), base_err);
   else
     std::printf("   max error against the builder's float targets: not known (a file, not built here); the baseline "
-                "decodes to the AFM's quanta exactly\n");
+                "holds the AFM's deltas rounded to whole quanta per vertex\n");
 
   const double load_raw = median_seconds([&] { load_into_player(raw); });
   const double load_draco = median_seconds([&] { load_into_player(draco); });
@@ -444,8 +497,7 @@ int main(int argc, char **argv) {
     measure(build("reference head, " + std::to_string(n) + " skin vertices", h->scene, h->fdps, threads));
   }
   if (std::find(sizes.begin(), sizes.end(), 10000) == sizes.end())
-    std::printf("(the 10k reference head is left out: its build takes about 7 minutes on one core; "
-                "--vertices 10000 adds it)\n");
+    std::printf("(the 10k reference head is left out to keep make bench short; --vertices 10000 adds it)\n");
 
   const char *shared = std::getenv("AFM_SHARED_DIR");
   const std::filesystem::path dir =

@@ -4,7 +4,7 @@
 #
 # Seed corpora are made here, never committed: small reference heads
 # (afm-headgen + afm-import), the same with synthetic targets and rigid parts
-# (tests/arm/afm_synth), tiny files of every chunk kind (fuzz/afm_seed), each
+# (tests/arm/afm_synth, once with control points: LIFT), tiny files of every chunk kind (fuzz/afm_seed), each
 # raw and draco; and the .fap files of ../shared/data/fap plus a synthetic one.
 # Working corpora stay in $FUZZ_DIR/corpus/<target>/ between runs; crash
 # inputs go to $FUZZ_DIR/crashes/, logs to $FUZZ_DIR/<target>.log.
@@ -29,6 +29,8 @@ if ! "$FUZZ_DIR/afm_seed" "$tmp" ||
    ! "$bin/afm-headgen" --vertices 1000 -o "$tmp/head.obj" --fdp "$tmp/head.fdp" >/dev/null ||
    ! "$bin/afm-import" "$tmp/head.obj" "$tmp/head.fdp" -o "$tmp/head.afm" >/dev/null ||
    ! "$AFM_BUILD/arm/afm_synth" "$tmp/head.afm" "$tmp/head-synth.afm" >/dev/null ||
+   ! "$AFM_BUILD/arm/afm_synth" --lift "$tmp/head.afm" "$tmp/head-lift.afm" >/dev/null ||
+   ! "$bin/afm-pack" --draco "$tmp/head-lift.afm" "$tmp/head-lift-draco.afm" >/dev/null ||
    ! "$bin/afm-pack" --draco "$tmp/head.afm" "$tmp/head-draco.afm" >/dev/null ||
    ! "$bin/afm-pack" --draco "$tmp/head-synth.afm" "$tmp/head-synth-draco.afm" >/dev/null; then
   echo "fuzz: cannot make the AFM seeds"

@@ -66,41 +66,87 @@ Grid position_grid(const Scene &scene) {
   return g;
 }
 
+// The lift's shape against the scene and the targets.
+Status check_lift(const AfmContent &content) {
+  const Scene &scene = *content.scene;
+  const ControlLift &lift = content.lift;
+  if (lift.control_count < 0 || (lift.control_count == 0 && !lift.parts.empty()))
+    return Status::error("encode_afm: a lift without control points");
+  if (lift.control_count == 0) {
+    for (const MorphTarget &t : content.targets)
+      if (t.controls.rows() > 0)
+        return Status::error("encode_afm: target " + std::to_string(t.number) + " moves controls, and there is no lift");
+    return Status::ok();
+  }
+  std::vector<char> seen(scene.parts.size(), 0);
+  for (const SkinBinding &b : lift.parts) {
+    if (b.part < 0 || static_cast<size_t>(b.part) >= scene.parts.size() || seen[static_cast<size_t>(b.part)])
+      return Status::error("encode_afm: lift part " + std::to_string(b.part) + " unknown or listed twice");
+    seen[static_cast<size_t>(b.part)] = 1;
+    const std::string name = scene.parts[static_cast<size_t>(b.part)].name;
+    if (b.corner.rows() != scene.parts[static_cast<size_t>(b.part)].V.rows() || b.corner.cols() != 3 ||
+        b.weight.rows() != b.corner.rows() || b.weight.cols() != 3)
+      return Status::error("encode_afm: the lift of part '" + name + "' is not #V x 3");
+    if (b.corner.size() > 0 && (b.corner.minCoeff() < 0 || b.corner.maxCoeff() >= lift.control_count))
+      return Status::error("encode_afm: the lift of part '" + name + "' names a control out of range");
+    if (b.weight.size() > 0 && !(b.weight.minCoeff() >= 0 && b.weight.maxCoeff() <= 1))
+      return Status::error("encode_afm: the lift of part '" + name + "' has a weight outside [0, 1]");
+  }
+  for (const MorphTarget &t : content.targets) {
+    if (t.normals)
+      return Status::error("encode_afm: a lifted AFM has no normal deltas (target " + std::to_string(t.number) + ")");
+    if (t.controls.rows() != 0 && (t.controls.rows() != lift.control_count || t.controls.cols() != 3))
+      return Status::error("encode_afm: target " + std::to_string(t.number) + ": controls are not #C x 3");
+  }
+  return Status::ok();
+}
+
 }  // namespace
 
 double afm_position_quantum(const Scene &scene) { return static_cast<double>(position_grid(scene).step); }
+
+namespace {
+
+// The order of n points that keeps each field's moved points in few runs:
+// sorted by which fields move them (fields taken largest first), ties in
+// index order. `fields` are #n x 3 displacements (others are ignored).
+std::vector<int> membership_order(size_t n, const std::vector<const Eigen::MatrixXd *> &fields, double quantum) {
+  std::vector<std::vector<char>> columns;
+  std::vector<size_t> sizes;
+  for (const Eigen::MatrixXd *D : fields) {
+    if (!D || D->rows() != static_cast<Eigen::Index>(n)) continue;
+    std::vector<char> moved(n, 0);
+    size_t count = 0;
+    for (size_t v = 0; v < n; ++v)
+      if (D->row(static_cast<Eigen::Index>(v)).cwiseAbs().maxCoeff() >= quantum / 2) moved[v] = 1, ++count;
+    if (count) columns.push_back(std::move(moved)), sizes.push_back(count);
+  }
+  std::vector<size_t> by_size(columns.size());
+  std::iota(by_size.begin(), by_size.end(), size_t{0});
+  std::stable_sort(by_size.begin(), by_size.end(), [&](size_t a, size_t b) { return sizes[a] > sizes[b]; });
+  std::vector<int> order(n);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    for (size_t c : by_size) {
+      char x = columns[c][static_cast<size_t>(a)], y = columns[c][static_cast<size_t>(b)];
+      if (x != y) return x > y;  // moved points first, grouped by signature
+    }
+    return false;
+  });
+  return order;
+}
+
+}  // namespace
 
 std::vector<std::vector<int>> run_friendly_order(const Scene &scene,
                                                  const std::vector<MorphTarget> &targets,
                                                  double quantum) {
   std::vector<std::vector<int>> order(scene.parts.size());
   for (size_t p = 0; p < scene.parts.size(); ++p) {
-    const size_t V = static_cast<size_t>(scene.parts[p].V.rows());
-    // Targets moving this part, largest first, as membership columns.
-    std::vector<std::vector<char>> columns;
-    std::vector<size_t> sizes;
-    for (const MorphTarget &t : targets) {
-      if (p >= t.displacement.size() || t.displacement[p].rows() != static_cast<Eigen::Index>(V))
-        continue;
-      std::vector<char> moved(V, 0);
-      size_t n = 0;
-      for (size_t v = 0; v < V; ++v)
-        if (t.displacement[p].row(static_cast<Eigen::Index>(v)).cwiseAbs().maxCoeff() >= quantum / 2)
-          moved[v] = 1, ++n;
-      if (n) columns.push_back(std::move(moved)), sizes.push_back(n);
-    }
-    std::vector<size_t> by_size(columns.size());
-    std::iota(by_size.begin(), by_size.end(), size_t{0});
-    std::stable_sort(by_size.begin(), by_size.end(), [&](size_t a, size_t b) { return sizes[a] > sizes[b]; });
-    order[p].resize(V);
-    std::iota(order[p].begin(), order[p].end(), 0);
-    std::stable_sort(order[p].begin(), order[p].end(), [&](int a, int b) {
-      for (size_t c : by_size) {
-        char x = columns[c][static_cast<size_t>(a)], y = columns[c][static_cast<size_t>(b)];
-        if (x != y) return x > y;  // moved vertices first, grouped by signature
-      }
-      return false;
-    });
+    std::vector<const Eigen::MatrixXd *> fields;
+    for (const MorphTarget &t : targets)
+      if (p < t.displacement.size()) fields.push_back(&t.displacement[p]);
+    order[p] = membership_order(static_cast<size_t>(scene.parts[p].V.rows()), fields, quantum);
   }
   return order;
 }
@@ -142,15 +188,29 @@ RenderVertices split_render_vertices(const Scene &scene, const std::vector<std::
   return rv;
 }
 
+RenderVertices afm_render_vertices(const AfmContent &content) {
+  const Scene &scene = *content.scene;
+  if (content.targets.empty()) return split_render_vertices(scene);
+  std::vector<std::vector<int>> order = run_friendly_order(scene, content.targets, position_grid(scene).step);
+  // Bound parts keep their file order: their targets live on the controls,
+  // and a spatial order lets Draco predict the bindings.
+  for (const SkinBinding &b : content.lift.parts)
+    if (b.part >= 0 && static_cast<size_t>(b.part) < order.size())
+      std::iota(order[static_cast<size_t>(b.part)].begin(), order[static_cast<size_t>(b.part)].end(), 0);
+  return split_render_vertices(scene, &order);
+}
+
 Expected<std::vector<uint8_t>> encode_afm(const AfmContent &content, afm_profile profile) {
   if (!content.scene || !content.fdps) return Status::error("encode_afm: no scene or FDPs");
   const Scene &scene = *content.scene;
   if (scene.parts.empty()) return Status::error(scene.source + ": the scene has no parts");
   if (scene.parts.size() > 65535) return Status::error(scene.source + ": more than 65535 parts");
   const Grid grid = position_grid(scene);
-  std::vector<std::vector<int>> order;
-  if (!content.targets.empty()) order = run_friendly_order(scene, content.targets, grid.step);
-  const RenderVertices rv = split_render_vertices(scene, order.empty() ? nullptr : &order);
+  const ControlLift &lift = content.lift;
+  if (Status st = check_lift(content); !st) return st;
+  std::vector<char> bound(scene.parts.size(), 0);  // parts the controls move
+  for (const SkinBinding &b : lift.parts) bound[static_cast<size_t>(b.part)] = 1;
+  const RenderVertices rv = afm_render_vertices(content);
   if (rv.count > 0xFFFFFFF0u) return Status::error(scene.source + ": too many vertices for AFM");
   const size_t R = rv.count;
 
@@ -250,6 +310,48 @@ Expected<std::vector<uint8_t>> encode_afm(const AfmContent &content, afm_profile
     fdps.push_back(a);
   }
 
+  // Control points: numbered so each target's controls form few runs
+  // (control_slot: model control -> file control; Draco's MTGT stream is 30 %
+  // smaller on Song than with the simulation mesh's order), and the bound
+  // render vertices with their Q15 weights.
+  std::vector<int> control_slot(static_cast<size_t>(lift.control_count));
+  std::vector<afm_run> lift_runs;
+  std::vector<uint32_t> lift_c[3];
+  std::vector<uint16_t> lift_w[2];
+  afm_lift doc_lift{};
+  if (lift.control_count > 0) {
+    std::vector<const Eigen::MatrixXd *> fields;
+    for (const MorphTarget &t : content.targets) fields.push_back(&t.controls);
+    const std::vector<int> by_slot = membership_order(static_cast<size_t>(lift.control_count), fields, grid.step);
+    for (size_t i = 0; i < by_slot.size(); ++i) control_slot[static_cast<size_t>(by_slot[i])] = static_cast<int>(i);
+    std::vector<std::pair<uint32_t, std::array<uint32_t, 5>>> rows;  // render vertex: c0 c1 c2 w1 w2
+    for (const SkinBinding &b : lift.parts)
+      for (Eigen::Index w = 0; w < b.corner.rows(); ++w) {
+        const long w1 = std::lround(b.weight(w, 1) * 32768.0), w2 = std::lround(b.weight(w, 2) * 32768.0);
+        std::array<uint32_t, 5> row{};
+        for (int k = 0; k < 3; ++k)
+          row[static_cast<size_t>(k)] = static_cast<uint32_t>(control_slot[static_cast<size_t>(b.corner(w, k))]);
+        row[3] = static_cast<uint32_t>(w1);
+        row[4] = static_cast<uint32_t>(std::min(w2, 32768L - w1));  // the rounded pair stays within one
+        for (uint32_t r : rv.copies[static_cast<size_t>(b.part)][static_cast<size_t>(w)]) rows.push_back({r, row});
+      }
+    std::sort(rows.begin(), rows.end(), [](const auto &x, const auto &y) { return x.first < y.first; });
+    for (const auto &[r, row] : rows) {
+      if (!lift_runs.empty() && lift_runs.back().start + lift_runs.back().length == r)
+        lift_runs.back().length++;
+      else
+        lift_runs.push_back({r, 1});
+      for (int k = 0; k < 3; ++k) lift_c[k].push_back(row[static_cast<size_t>(k)]);
+      for (int k = 0; k < 2; ++k) lift_w[k].push_back(static_cast<uint16_t>(row[static_cast<size_t>(3 + k)]));
+    }
+    doc_lift.control_count = static_cast<uint32_t>(lift.control_count);
+    doc_lift.run_count = static_cast<uint32_t>(lift_runs.size());
+    doc_lift.runs = lift_runs.data();
+    doc_lift.bound_count = static_cast<uint32_t>(rows.size());
+    doc_lift.c0 = lift_c[0].data(), doc_lift.c1 = lift_c[1].data(), doc_lift.c2 = lift_c[2].data();
+    doc_lift.w1 = lift_w[0].data(), doc_lift.w2 = lift_w[1].data();
+  }
+
   // Morph targets: quantise, drop zero deltas, runs over render vertices
   // (a one-vertex gap is cheaper stored as zeros than as a new 8-byte run).
   struct TargetStore {
@@ -265,10 +367,11 @@ Expected<std::vector<uint8_t>> encode_afm(const AfmContent &content, afm_profile
     for (size_t p = 0; p < scene.parts.size() && mt.normals; ++p)
       if (p < mt.displacement.size() && mt.displacement[p].rows() == scene.parts[p].V.rows())
         moved_normals[p] = vertex_normals(scene.parts[p].V + mt.displacement[p], scene.parts[p].F);
-    // Quantised deltas by render vertex, then runs in ascending order.
+    // Quantised deltas by entry (render vertex, then control), then runs in
+    // ascending order.
     std::vector<std::pair<uint32_t, std::array<int16_t, 6>>> moved;
     for (size_t p = 0; p < scene.parts.size(); ++p) {
-      if (p >= mt.displacement.size() || mt.displacement[p].rows() == 0) continue;
+      if (p >= mt.displacement.size() || mt.displacement[p].rows() == 0 || bound[p]) continue;
       const Eigen::MatrixXd &D = mt.displacement[p];
       if (D.rows() != scene.parts[p].V.rows() || D.cols() != 3)
         return Status::error("target " + std::to_string(mt.number) + ": displacement of part '" +
@@ -283,6 +386,13 @@ Expected<std::vector<uint8_t>> encode_afm(const AfmContent &content, afm_profile
         if (q == std::array<int16_t, 6>{}) continue;
         for (uint32_t r : rv.copies[p][static_cast<size_t>(w)]) moved.push_back({r, q});
       }
+    }
+    for (Eigen::Index c = 0; c < mt.controls.rows(); ++c) {
+      std::array<int16_t, 6> q{};
+      for (int k = 0; k < 3; ++k)
+        q[static_cast<size_t>(k)] = clamp16(std::lround(mt.controls(c, k) / static_cast<double>(grid.step)));
+      if (q != std::array<int16_t, 6>{})
+        moved.push_back({static_cast<uint32_t>(R + static_cast<size_t>(control_slot[static_cast<size_t>(c)])), q});
     }
     std::sort(moved.begin(), moved.end(), [](const auto &x, const auto &y) { return x.first < y.first; });
     for (const auto &[r, q] : moved) {
@@ -366,6 +476,7 @@ Expected<std::vector<uint8_t>> encode_afm(const AfmContent &content, afm_profile
   doc.targets = targets.data();
   doc.rigid_count = static_cast<uint32_t>(rigids.size());
   doc.rigids = rigids.data();
+  if (lift.control_count > 0) doc.lift = &doc_lift;
 
   afm_write_options wo{};
   afm_diag diag{};

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "anatomy/skin_binding.h"
 #include "core/fdp.h"
 #include "core/scene.h"
 #include "core/status.h"
@@ -31,6 +32,17 @@ struct MorphTarget {
   // part does not move.
   std::vector<Eigen::MatrixXd> displacement;
   bool normals = false;    // also store normal deltas
+  // With AfmContent::lift: #C x 3 displacement of the control points, model
+  // units (empty: they do not move). The bound parts' displacement must be
+  // its lift; the AFM stores the controls instead.
+  Eigen::MatrixXd controls;
+};
+
+// Control points (formats/afm.md, LIFT): whole parts whose every vertex
+// moves as a blend of three controls (the simulation mesh's vertices).
+struct ControlLift {
+  int control_count = 0;            // #C
+  std::vector<SkinBinding> parts;   // per bound part: corners index the controls
 };
 
 // A rigid transform (eyeball, jaw, head) in model units.
@@ -53,6 +65,7 @@ struct AfmContent {
   Fapu fapu;
   std::vector<MorphTarget> targets;
   std::vector<RigidPart> rigids;
+  ControlLift lift;  // control_count 0: none; then no target may have normals
   std::string generator = "afm toolkit";
 };
 
@@ -78,6 +91,11 @@ RenderVertices split_render_vertices(const Scene &scene,
 std::vector<std::vector<int>> run_friendly_order(const Scene &scene,
                                                  const std::vector<MorphTarget> &targets,
                                                  double quantum);
+
+// Where encode_afm puts each welded vertex of `content`'s scene: its vertex
+// order (run_friendly_order, with parts bound to control points kept in file
+// order) and seam split.
+RenderVertices afm_render_vertices(const AfmContent &content);
 
 // The model units per quantum of the AFM position grid encode_afm() uses for
 // this scene (positions and morph target deltas alike): the largest half

@@ -87,25 +87,17 @@ std::vector<std::string> target_names(const afm_doc &doc) {
   return names;
 }
 
-Eigen::MatrixXi target_part_deltas(const afm_target &t, const afm_part &part) {
-  Eigen::MatrixXi d = Eigen::MatrixXi::Zero(part.vertex_count, 3);
-  const uint32_t lo = part.first_vertex, hi = part.first_vertex + part.vertex_count;
-  uint32_t k = 0;  // index of the run's first delta
-  for (uint32_t r = 0; r < t.run_count; k += t.runs[r].length, ++r) {
-    const afm_run &run = t.runs[r];
-    for (uint32_t j = 0; j < run.length; ++j) {
-      const uint32_t v = run.start + j;
-      if (v < lo || v >= hi) continue;
-      d(v - lo, 0) = t.dx[k + j];
-      d(v - lo, 1) = t.dy[k + j];
-      d(v - lo, 2) = t.dz[k + j];
-    }
-  }
+Eigen::MatrixXd target_part_deltas(const afm_doc &doc, const afm_target &t, const afm_part &part) {
+  std::vector<int32_t> q15(3 * static_cast<size_t>(afm_doc_entry_count(&doc)));
+  Eigen::MatrixXd d = Eigen::MatrixXd::Zero(part.vertex_count, 3);
+  if (afm_target_expand(&doc, &t, q15.data()) != AFM_OK) return d;  // a doc the reader accepted
+  for (uint32_t i = 0; i < part.vertex_count; ++i)
+    for (int c = 0; c < 3; ++c) d(i, c) = q15[3 * size_t(part.first_vertex + i) + size_t(c)] / 32768.0;
   return d;
 }
 
-bool target_moves_part(const afm_target &t, const afm_part &part) {
-  return target_part_deltas(t, part).any();
+bool target_moves_part(const afm_doc &doc, const afm_target &t, const afm_part &part) {
+  return (target_part_deltas(doc, t, part).array() != 0).any();
 }
 
 int position_decimals(float step) {
@@ -117,16 +109,16 @@ int position_decimals(float step) {
 Eigen::MatrixXd part_positions(const afm_doc &doc, const afm_part &part, const afm_target *target,
                                int decimals) {
   const afm_geometry &g = doc.geometry;
-  Eigen::MatrixXi q(part.vertex_count, 3);
+  Eigen::MatrixXd q(part.vertex_count, 3);
   for (uint32_t i = 0; i < part.vertex_count; ++i) {
     const uint32_t v = part.first_vertex + i;
     q(i, 0) = g.px[v], q(i, 1) = g.py[v], q(i, 2) = g.pz[v];
   }
-  if (target) q += target_part_deltas(*target, part);
+  if (target) q += target_part_deltas(doc, *target, part);
   Eigen::MatrixXd p(part.vertex_count, 3);
   for (uint32_t i = 0; i < part.vertex_count; ++i)
     for (int c = 0; c < 3; ++c)
-      p(i, c) = round_to(double(g.origin[c]) + double(q(i, c)) * double(g.step), decimals);
+      p(i, c) = round_to(double(g.origin[c]) + q(i, c) * double(g.step), decimals);
   return p;
 }
 

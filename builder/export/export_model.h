@@ -52,12 +52,13 @@ std::string target_name(const afm_target &target);
 // Every target's name, in doc.targets order.
 std::vector<std::string> target_names(const afm_doc &doc);
 
-// The target's position deltas on one part: #part.vertex_count x 3, in
-// quanta, zero where its runs do not reach.
-Eigen::MatrixXi target_part_deltas(const afm_target &target, const afm_part &part);
+// The target's position deltas on one part of doc: #part.vertex_count x 3,
+// in quanta, zero where it does not reach. Vertices bound to control points
+// (LIFT) get their lifted deltas, which may be fractions of a quantum.
+Eigen::MatrixXd target_part_deltas(const afm_doc &doc, const afm_target &target, const afm_part &part);
 
 // Whether the target moves any vertex of the part (a nonzero delta).
-bool target_moves_part(const afm_target &target, const afm_part &part);
+bool target_moves_part(const afm_doc &doc, const afm_target &target, const afm_part &part);
 
 // Decimal places that write positions of grid step `step` to within a tenth
 // of a step: a file with them reads back to the same quanta, and target

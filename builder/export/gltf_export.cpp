@@ -253,7 +253,7 @@ class GltfBuilder {
       MeshInfo m;
       m.part = int(pi);
       for (uint32_t t = 0; t < doc_.target_count; ++t)
-        if (target_moves_part(doc_.targets[t], p)) m.targets.push_back(t);
+        if (target_moves_part(doc_, doc_.targets[t], p)) m.targets.push_back(t);
       part_mesh_[pi] = int(meshes_.size());
       meshes_.push_back(m);
     }
@@ -346,13 +346,13 @@ class GltfBuilder {
   // A sparse POSITION morph target: the vertices the target moves in this
   // part, with their displacement in model units.
   int target_accessor(const afm_target &t, const afm_part &p) {
-    const Eigen::MatrixXi d = target_part_deltas(t, p);
+    const Eigen::MatrixXd d = target_part_deltas(doc_, t, p);
     std::vector<uint32_t> idx;
     std::vector<float> val;
     for (uint32_t i = 0; i < p.vertex_count; ++i) {
-      if (!d.row(i).any()) continue;
+      if ((d.row(i).array() == 0).all()) continue;
       idx.push_back(i);
-      for (int c = 0; c < 3; ++c) val.push_back(float(double(d(i, c)) * g_.step));
+      for (int c = 0; c < 3; ++c) val.push_back(float(d(i, c) * g_.step));
     }
     Accessor a;
     a.count = p.vertex_count;

@@ -37,8 +37,8 @@ Expected<std::string> vrml_afm_text(const afm_doc &doc, const std::string &sourc
   for (uint32_t t = 0; t < doc.target_count; ++t) {
     for (uint32_t pi = 0; pi < g.part_count; ++pi) {
       const afm_part &ap = g.parts[pi];
-      const Eigen::MatrixXi d = target_part_deltas(doc.targets[t], ap);
-      if (!d.any()) continue;
+      const Eigen::MatrixXd d = target_part_deltas(doc, doc.targets[t], ap);
+      if ((d.array() == 0).all()) continue;
       Part p;
       p.name = names[t] + "__" + neutral.parts[pi].name;
       p.kind = neutral.parts[pi].kind;

@@ -181,7 +181,8 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
   for (PartKind k : {PartKind::TeethLower, PartKind::Tongue})
     if (int p = scene.find_kind(k); p >= 0) out.jaw.parts.push_back(p);
   // Lashes and lid strips ride on the skin (skin_binding.h).
-  const std::vector<SkinBinding> carried = bind_to_skin(scene, model.skin, PartKind::Eyelid);
+  out.carried = bind_to_skin(scene, model.skin, PartKind::Eyelid);
+  const std::vector<SkinBinding> &carried = out.carried;
   auto carry = [&carried](const Eigen::MatrixXd &D, MorphTarget &t) {
     for (const SkinBinding &b : carried) {
       Eigen::MatrixXd d = carried_displacement(b, D);
@@ -589,12 +590,17 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
 void lift_synthesis(FapSynthesis &synthesis, const SimMesh &sim) {
   if (!sim.decimated) return;
   const size_t skin = static_cast<size_t>(sim.skin);
+  synthesis.lift.control_count = static_cast<int>(sim.V.rows());
+  synthesis.lift.parts = {sim.binding};
+  synthesis.lift.parts[0].part = sim.skin;
+  for (const SkinBinding &b : synthesis.carried) synthesis.lift.parts.push_back(b);
   size_t next = 0;  // targets are the made outcomes, in order
   for (FapOutcome &o : synthesis.outcomes) {
     if (!o.made) continue;
     MorphTarget &t = synthesis.targets[next++];
     if (skin >= t.displacement.size() || t.displacement[skin].rows() == 0) continue;
-    t.displacement[skin] = lift_displacement(sim, t.displacement[skin]);
+    t.controls = t.displacement[skin];
+    t.displacement[skin] = lift_displacement(sim, t.controls);
     if (o.kind != AFM_TARGET_FAP) o.largest = t.displacement[skin].rowwise().norm().maxCoeff();
   }
 }
@@ -607,6 +613,7 @@ AfmContent fap_afm_content(const Scene &scene, const FdpSet &fdps, const FaceMod
   c.targets = std::move(synthesis.targets);
   c.rigids = eye_and_head_rigids(scene, fdps, model.fapu, model.skin);
   if (!synthesis.jaw.parts.empty()) c.rigids.push_back(std::move(synthesis.jaw));
+  c.lift = std::move(synthesis.lift);
   return c;
 }
 

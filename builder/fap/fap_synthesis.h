@@ -114,6 +114,12 @@ struct FapSynthesis {
   std::vector<MorphTarget> targets;
   std::vector<FapOutcome> outcomes;  // every attempted one, in the same order
   RigidPart jaw;                     // the jaw's rigid parts and controls (parts empty: none)
+  // Parts carried by the skin (lashes, lid strips), bound to the skin the
+  // synthesis ran on.
+  std::vector<SkinBinding> carried;
+  // After lift_synthesis on a decimated simulation mesh: the simulation
+  // vertices as the AFM's control points (each target's `controls`).
+  ControlLift lift;
 };
 
 // Fails only on a model without skin; a FAP that cannot be made is an
@@ -124,7 +130,10 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
 // Carries a synthesis made on a simulation mesh (sim_mesh.h: the model built
 // on sim_scene) to the skin: every target's skin displacement becomes #V x 3
 // over the skin's own vertices, and the `largest` of each viseme and
-// expression is measured there. Nothing changes when the simulation mesh is the skin.
+// expression is measured there. The simulation mesh's displacement becomes
+// the target's `controls`, and `lift` binds the skin and the carried parts
+// to them (formats/afm.md, LIFT). Nothing changes when the simulation mesh
+// is the skin.
 void lift_synthesis(FapSynthesis &synthesis, const SimMesh &sim);
 
 // The AFM's content: the scene, its input FDPs (bound to `scene`; not the

@@ -9,6 +9,8 @@
 // MTGT: target headers and runs stay as they are; all position deltas (and
 // normal deltas) form Draco point clouds in sequential order, where Draco's
 // difference prediction and entropy coding work on neighbouring vertices.
+// LIFT: counts and runs stay as they are; the bound vertices' control
+// triples and weight pairs form one sequential point cloud.
 //
 // Every encoded chunk is decoded again and compared before it is accepted:
 // a file never depends on a Draco round trip that was not checked.
@@ -37,6 +39,8 @@ enum : uint32_t {
   kUidColor = 3,
   kUidVertexId = 4,
   kUidDelta = 10,
+  kUidLiftControls = 11,
+  kUidLiftWeights = 12,
 };
 
 constexpr int kSpeed = 3;  // Draco encode/decode speed (0 best .. 10 fastest); bench/ measures it
@@ -546,14 +550,8 @@ afm_result geom_to_raw(const uint8_t *data, size_t size, const afm_allocator *al
 
 // ---- MTGT -------------------------------------------------------------------
 
-// All values of `n` points with 3 int16 components as a sequential point cloud.
-std::vector<uint8_t> encode_triples(const std::vector<int16_t> &values) {
-  size_t n = values.size() / 3;
-  if (n == 0) return {};
-  draco::PointCloud pc;
-  pc.set_num_points(static_cast<uint32_t>(n));
-  add_attribute(pc, draco::GeometryAttribute::GENERIC, 3, draco::DT_INT16, 2, kUidDelta,
-                values.data(), n);
+// A point cloud in sequential order (empty on failure).
+std::vector<uint8_t> encode_sequential(const draco::PointCloud &pc) {
   draco::Encoder enc;
   enc.SetSpeedOptions(kSpeed, kSpeed);
   enc.SetEncodingMethod(draco::POINT_CLOUD_SEQUENTIAL_ENCODING);
@@ -562,15 +560,33 @@ std::vector<uint8_t> encode_triples(const std::vector<int16_t> &values) {
   return std::vector<uint8_t>(buf.data(), buf.data() + buf.size());
 }
 
-bool decode_triples(const uint8_t *data, size_t size, size_t n, std::vector<int16_t> &out) {
-  out.assign(3 * n, 0);
-  if (n == 0) return size == 0;
+// All values of `n` points with 3 int16 components as a sequential point cloud.
+std::vector<uint8_t> encode_triples(const std::vector<int16_t> &values) {
+  size_t n = values.size() / 3;
+  if (n == 0) return {};
+  draco::PointCloud pc;
+  pc.set_num_points(static_cast<uint32_t>(n));
+  add_attribute(pc, draco::GeometryAttribute::GENERIC, 3, draco::DT_INT16, 2, kUidDelta,
+                values.data(), n);
+  return encode_sequential(pc);
+}
+
+// A point cloud from a Draco stream; null when it does not decode.
+std::unique_ptr<draco::PointCloud> decode_cloud(const uint8_t *data, size_t size) {
   draco::DecoderBuffer buf;
   buf.Init(reinterpret_cast<const char *>(data), size);
   draco::Decoder dec;
   auto r = dec.DecodePointCloudFromBuffer(&buf);
-  if (!r.ok()) return false;
-  const draco::PointCloud &pc = *r.value();
+  if (!r.ok()) return nullptr;
+  return std::move(r).value();
+}
+
+bool decode_triples(const uint8_t *data, size_t size, size_t n, std::vector<int16_t> &out) {
+  out.assign(3 * n, 0);
+  if (n == 0) return size == 0;
+  const std::unique_ptr<draco::PointCloud> cloud = decode_cloud(data, size);
+  if (!cloud) return false;
+  const draco::PointCloud &pc = *cloud;
   const draco::PointAttribute *a = pc.GetAttributeByUniqueId(kUidDelta);
   if (!a || pc.num_points() != n || a->num_components() != 3 || a->data_type() != draco::DT_INT16)
     return false;
@@ -714,6 +730,130 @@ afm_result mtgt_to_raw(const uint8_t *data, size_t size, const afm_allocator *al
   return AFM_OK;
 }
 
+// ---- LIFT -------------------------------------------------------------------
+
+// The raw LIFT payload's parts (formats/afm.md); `ok` false when it does not
+// parse. The document reader checks the values themselves.
+struct LiftRaw {
+  uint32_t controls = 0, run_count = 0, bound = 0;
+  std::vector<uint32_t> runs;      // 2 per run
+  std::vector<uint32_t> c;         // 3 per bound vertex: c0 c1 c2
+  std::vector<uint16_t> w;         // 2 per bound vertex: w1 w2
+  bool ok = false;
+};
+
+LiftRaw parse_lift(const uint8_t *raw, size_t size) {
+  LiftRaw l;
+  In in{raw, size};
+  l.controls = in.u32(), l.run_count = in.u32(), l.bound = in.u32();
+  if (!in.ok || l.run_count > (size - in.pos) / 8 || l.bound > (size - in.pos) / 16) return l;
+  l.runs.resize(2 * static_cast<size_t>(l.run_count));
+  for (uint32_t &v : l.runs) v = in.u32();
+  l.c.resize(3 * static_cast<size_t>(l.bound));
+  for (int k = 0; k < 3; ++k)
+    for (uint32_t b = 0; b < l.bound; ++b) l.c[3 * b + static_cast<size_t>(k)] = in.u32();
+  l.w.resize(2 * static_cast<size_t>(l.bound));
+  for (int k = 0; k < 2; ++k) {
+    for (uint32_t b = 0; b < l.bound; ++b) l.w[2 * b + static_cast<size_t>(k)] = in.u16();
+    in.pad4();
+  }
+  l.ok = in.ok && in.pos == size;
+  return l;
+}
+
+std::vector<uint8_t> lift_raw_bytes(const LiftRaw &l) {
+  Out o;
+  o.u32(l.controls), o.u32(l.run_count), o.u32(l.bound);
+  for (uint32_t v : l.runs) o.u32(v);
+  for (int k = 0; k < 3; ++k)
+    for (uint32_t b = 0; b < l.bound; ++b) o.u32(l.c[3 * b + static_cast<size_t>(k)]);
+  for (int k = 0; k < 2; ++k) {
+    for (uint32_t b = 0; b < l.bound; ++b) o.u16(l.w[2 * b + static_cast<size_t>(k)]);
+    o.pad4();
+  }
+  return o.b;
+}
+
+std::vector<uint8_t> encode_lift_cloud(const LiftRaw &l) {
+  if (l.bound == 0) return {};
+  draco::PointCloud pc;
+  pc.set_num_points(l.bound);
+  add_attribute(pc, draco::GeometryAttribute::GENERIC, 3, draco::DT_UINT32, 4, kUidLiftControls, l.c.data(), l.bound);
+  add_attribute(pc, draco::GeometryAttribute::GENERIC, 2, draco::DT_UINT16, 2, kUidLiftWeights, l.w.data(), l.bound);
+  return encode_sequential(pc);
+}
+
+bool decode_lift_cloud(const uint8_t *data, size_t size, LiftRaw &l) {
+  l.c.assign(3 * static_cast<size_t>(l.bound), 0);
+  l.w.assign(2 * static_cast<size_t>(l.bound), 0);
+  if (l.bound == 0) return size == 0;
+  const std::unique_ptr<draco::PointCloud> cloud = decode_cloud(data, size);
+  if (!cloud) return false;
+  const draco::PointCloud &pc = *cloud;
+  const draco::PointAttribute *c = pc.GetAttributeByUniqueId(kUidLiftControls);
+  const draco::PointAttribute *w = pc.GetAttributeByUniqueId(kUidLiftWeights);
+  if (!c || !w || pc.num_points() != l.bound || c->num_components() != 3 || c->data_type() != draco::DT_UINT32 ||
+      w->num_components() != 2 || w->data_type() != draco::DT_UINT16)
+    return false;
+  for (uint32_t p = 0; p < l.bound; ++p) {
+    c->GetMappedValue(draco::PointIndex(p), &l.c[3 * p]);
+    w->GetMappedValue(draco::PointIndex(p), &l.w[2 * p]);
+  }
+  return true;
+}
+
+afm_result lift_from_raw(const uint8_t *raw, size_t raw_size, const afm_allocator *allocator, uint8_t **out,
+                         size_t *out_size) {
+  const LiftRaw l = parse_lift(raw, raw_size);
+  if (!l.ok) return AFM_OK;  // keep raw; the reader reports what is wrong
+  const std::vector<uint8_t> cloud = encode_lift_cloud(l);
+  LiftRaw back = l;
+  if ((l.bound && cloud.empty()) || !decode_lift_cloud(cloud.data(), cloud.size(), back) || back.c != l.c ||
+      back.w != l.w)
+    return AFM_OK;
+  Out o;
+  o.u32(static_cast<uint32_t>(raw_size));
+  o.u32(l.controls), o.u32(l.run_count), o.u32(l.bound);
+  for (uint32_t v : l.runs) o.u32(v);
+  o.u32(static_cast<uint32_t>(cloud.size()));
+  o.bytes(cloud.data(), cloud.size());
+  o.pad4();
+  if (o.b.size() * 100 > raw_size * (100 - AFM_DRACO_MIN_SAVING_PERCENT)) return AFM_OK;
+  return hand_out(o.b, allocator, out, out_size);
+}
+
+afm_result lift_to_raw(const uint8_t *data, size_t size, const afm_allocator *allocator, uint8_t **raw,
+                       size_t *raw_size, afm_diag *diag) {
+  In in{data, size};
+  LiftRaw l;
+  const uint32_t expect_size = in.u32();
+  l.controls = in.u32(), l.run_count = in.u32(), l.bound = in.u32();
+  // Draco needs at least a bit per value: bound the untrusted count.
+  if (!in.ok || l.run_count > (size - in.pos) / 8 || l.bound > 8 * size + 64) {
+    set_diag(diag, AFM_CHUNK_LIFT, "counts truncated or too large");
+    return AFM_ERR_TRUNCATED;
+  }
+  l.runs.resize(2 * static_cast<size_t>(l.run_count));
+  for (uint32_t &v : l.runs) v = in.u32();
+  const uint32_t len = in.u32();
+  const uint8_t *cloud = in.take(len);
+  in.pad4();
+  if (!in.ok || !decode_lift_cloud(cloud, len, l)) {
+    set_diag(diag, AFM_CHUNK_LIFT, "Draco stream truncated or invalid");
+    return AFM_ERR_DRACO;
+  }
+  if (in.pos != size) {
+    set_diag(diag, AFM_CHUNK_LIFT, "%zu bytes after the Draco stream", size - in.pos);
+    return AFM_ERR_TRAILING_BYTES;
+  }
+  const std::vector<uint8_t> bytes = lift_raw_bytes(l);
+  if (bytes.size() != expect_size) {
+    set_diag(diag, AFM_CHUNK_LIFT, "decodes to %zu raw bytes, header says %u", bytes.size(), expect_size);
+    return AFM_ERR_DRACO;
+  }
+  return hand_out(bytes, allocator, raw, raw_size);
+}
+
 // ---- C ABI ------------------------------------------------------------------
 
 afm_result to_raw(void *, uint32_t kind, const uint8_t *data, size_t size,
@@ -725,6 +865,7 @@ afm_result to_raw(void *, uint32_t kind, const uint8_t *data, size_t size,
   try {
     if (kind == AFM_CHUNK_GEOM) return geom_to_raw(data, size, allocator, raw, raw_size, diag);
     if (kind == AFM_CHUNK_MTGT) return mtgt_to_raw(data, size, allocator, raw, raw_size, diag);
+    if (kind == AFM_CHUNK_LIFT) return lift_to_raw(data, size, allocator, raw, raw_size, diag);
   } catch (const std::bad_alloc &) {
     return AFM_ERR_OUT_OF_MEMORY;
   } catch (...) {
@@ -744,6 +885,7 @@ afm_result from_raw(void *, uint32_t kind, const uint8_t *raw, size_t raw_size,
   try {
     if (kind == AFM_CHUNK_GEOM) return geom_from_raw(raw, raw_size, allocator, out, out_size, diag);
     if (kind == AFM_CHUNK_MTGT) return mtgt_from_raw(raw, raw_size, allocator, out, out_size, diag);
+    if (kind == AFM_CHUNK_LIFT) return lift_from_raw(raw, raw_size, allocator, out, out_size);
   } catch (const std::bad_alloc &) {
     return AFM_ERR_OUT_OF_MEMORY;
   } catch (...) {

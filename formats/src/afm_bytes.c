@@ -239,6 +239,31 @@ uint8_t *afm_read_u8_array(afm_reader *r, afm_arena *arena, size_t count, const 
   return (uint8_t *)read_array(r, arena, count, 1, field);
 }
 
+afm_run *afm_read_runs(afm_reader *r, afm_arena *arena, uint32_t count, uint32_t limit,
+                       const char *what, const char *limit_name, uint64_t *total) {
+  afm_run *runs = (afm_run *)afm_arena_take(arena, afm_mul_size(count, sizeof *runs));
+  uint32_t k, end = 0;
+  *total = 0;
+  for (k = 0; k < count; ++k) {
+    afm_run run;
+    run.start = afm_read_u32(r, "run.start");
+    run.length = afm_read_u32(r, "run.length");
+    if (r->error != AFM_OK) return NULL;
+    if (run.length == 0 || (k > 0 && run.start < end) || run.start > limit ||
+        run.length > limit - run.start) {
+      afm_fail(r, AFM_ERR_RANGE,
+               "%s: run %lu [%lu, +%lu) is empty, overlaps the previous run or passes %s %lu", what,
+               (unsigned long)k, (unsigned long)run.start, (unsigned long)run.length, limit_name,
+               (unsigned long)limit);
+      return NULL;
+    }
+    end = run.start + run.length;
+    *total += run.length;
+    if (runs) runs[k] = run;
+  }
+  return runs;
+}
+
 /* ---- writer --------------------------------------------------------------- */
 
 static uint8_t *room(afm_writer *w, size_t n) {

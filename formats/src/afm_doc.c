@@ -6,7 +6,7 @@
 
 /* ---- resolving chunks to raw payloads ------------------------------------ */
 
-enum { kMeta, kGeom, kMtgt, kRigd, kKnownCount };
+enum { kMeta, kGeom, kLift, kMtgt, kRigd, kKnownCount };
 
 typedef struct raw_chunks {
   const uint8_t *data[kKnownCount]; /* raw payload, or NULL when absent */
@@ -20,6 +20,7 @@ static int known_index(uint32_t kind) {
   switch (kind) {
     case AFM_CHUNK_META: return kMeta;
     case AFM_CHUNK_GEOM: return kGeom;
+    case AFM_CHUNK_LIFT: return kLift;
     case AFM_CHUNK_MTGT: return kMtgt;
     case AFM_CHUNK_RIGD: return kRigd;
     default: return -1;
@@ -108,7 +109,8 @@ static afm_result decode_chunks(const raw_chunks *rc, afm_diag *diag, afm_arena 
   afm_geometry geom;
   afm_target *targets = NULL;
   afm_rigid *rigids = NULL;
-  uint32_t target_count = 0, rigid_count = 0, i;
+  afm_lift *lift = NULL;
+  uint32_t target_count = 0, rigid_count = 0, control_count = 0, i;
   afm_result res;
 
   doc = (afm_doc *)afm_arena_take(arena, sizeof *doc);
@@ -117,9 +119,19 @@ static afm_result decode_chunks(const raw_chunks *rc, afm_diag *diag, afm_arena 
   res = afm_geometry_decode_at(rc->data[kGeom], rc->size[kGeom], rc->offset[kGeom], arena, &geom,
                                diag);
   if (res != AFM_OK) return res;
+  if (rc->data[kLift]) {
+    res = afm_lift_decode(rc->data[kLift], rc->size[kLift], rc->offset[kLift], geom.vertex_count,
+                          arena, &lift, diag);
+    if (res != AFM_OK) return res;
+    /* Measuring gives no struct: read the count (checked to fit with V). */
+    control_count = afm_load_u32(rc->data[kLift]);
+  }
   if (rc->data[kMtgt]) {
     res = afm_targets_decode_at(rc->data[kMtgt], rc->size[kMtgt], rc->offset[kMtgt],
-                                geom.vertex_count, arena, &target_count, &targets, diag);
+                                geom.vertex_count, control_count, arena, &target_count, &targets,
+                                diag);
+    if (res != AFM_OK) return res;
+    res = afm_lift_check_targets(lift, targets, target_count, rc->offset[kMtgt], diag);
     if (res != AFM_OK) return res;
   }
   if (rc->data[kRigd]) {
@@ -144,6 +156,7 @@ static afm_result decode_chunks(const raw_chunks *rc, afm_diag *diag, afm_arena 
   doc->rigid_count = rigid_count;
   doc->rigids = rigids;
   doc->skipped_chunks = rc->skipped;
+  doc->lift = lift;
   if (out) *out = doc;
   return AFM_OK;
 }
@@ -241,6 +254,9 @@ static afm_result enc_meta(const void *p, afm_writer *w) {
 static afm_result enc_geom(const void *p, afm_writer *w) {
   return afm_geometry_encode_to((const afm_geometry *)p, w);
 }
+static afm_result enc_lift(const void *p, afm_writer *w) {
+  return afm_lift_encode((const afm_lift *)p, w);
+}
 static afm_result enc_targets(const void *p, afm_writer *w) {
   const afm_doc *d = (const afm_doc *)p;
   return afm_targets_encode_to(d->targets, d->target_count, w);
@@ -267,14 +283,14 @@ static afm_result encode_payload(encode_fn fn, const void *what, const afm_alloc
 
 afm_result afm_doc_write(const afm_doc *doc, const afm_write_options *options, uint8_t **out,
                          size_t *out_size) {
-  static const uint32_t kinds[kKnownCount] = {AFM_CHUNK_META, AFM_CHUNK_GEOM, AFM_CHUNK_MTGT,
-                                              AFM_CHUNK_RIGD};
+  static const uint32_t kinds[kKnownCount] = {AFM_CHUNK_META, AFM_CHUNK_GEOM, AFM_CHUNK_LIFT,
+                                              AFM_CHUNK_MTGT, AFM_CHUNK_RIGD};
   const afm_allocator *alloc = options ? &options->allocator : NULL;
   afm_diag *diag = options ? options->diag : NULL;
   afm_profile profile = options ? options->profile : AFM_PROFILE_RAW;
-  uint8_t *raw[kKnownCount] = {NULL, NULL, NULL, NULL};
-  uint8_t *packed[kKnownCount] = {NULL, NULL, NULL, NULL};
-  size_t raw_size[kKnownCount] = {0, 0, 0, 0};
+  uint8_t *raw[kKnownCount] = {NULL, NULL, NULL, NULL, NULL};
+  uint8_t *packed[kKnownCount] = {NULL, NULL, NULL, NULL, NULL};
+  size_t raw_size[kKnownCount] = {0, 0, 0, 0, 0};
   afm_chunk_out chunks[kKnownCount];
   uint32_t *tris = NULL, count = 0;
   afm_geometry geom;
@@ -318,6 +334,8 @@ afm_result afm_doc_write(const afm_doc *doc, const afm_write_options *options, u
 
   res = encode_payload(enc_meta, &doc->meta, alloc, &raw[kMeta], &raw_size[kMeta]);
   if (res == AFM_OK) res = encode_payload(enc_geom, &geom, alloc, &raw[kGeom], &raw_size[kGeom]);
+  if (res == AFM_OK && doc->lift)
+    res = encode_payload(enc_lift, doc->lift, alloc, &raw[kLift], &raw_size[kLift]);
   if (res == AFM_OK && doc->target_count)
     res = encode_payload(enc_targets, doc, alloc, &raw[kMtgt], &raw_size[kMtgt]);
   if (res == AFM_OK && doc->rigid_count)
@@ -340,7 +358,7 @@ afm_result afm_doc_write(const afm_doc *doc, const afm_write_options *options, u
     chunks[count].encoding = AFM_ENCODING_RAW;
     chunks[count].data = raw[k];
     chunks[count].length = raw_size[k];
-    if (profile == AFM_PROFILE_DRACO && (k == kGeom || k == kMtgt)) {
+    if (profile == AFM_PROFILE_DRACO && (k == kGeom || k == kLift || k == kMtgt)) {
       size_t n = 0;
       res = options->draco->from_raw(options->draco->ctx, kinds[k], raw[k], raw_size[k], alloc,
                                      &packed[k], &n, diag);
@@ -421,7 +439,7 @@ afm_result afm_transcode(const uint8_t *data, size_t size, afm_profile profile,
     chunks[i].encoding = ch.encoding;
     chunks[i].data = ch.data;
     chunks[i].length = ch.length;
-    if ((ch.kind != AFM_CHUNK_GEOM && ch.kind != AFM_CHUNK_MTGT) ||
+    if ((ch.kind != AFM_CHUNK_GEOM && ch.kind != AFM_CHUNK_LIFT && ch.kind != AFM_CHUNK_MTGT) ||
         ch.encoding > AFM_ENCODING_DRACO)
       continue; /* copied as is */
     raw = ch.data;

@@ -54,6 +54,12 @@ int16_t *afm_read_i16_array(afm_reader *r, afm_arena *arena, size_t count, const
 uint16_t *afm_read_u16_array(afm_reader *r, afm_arena *arena, size_t count, const char *field);
 uint32_t *afm_read_u32_array(afm_reader *r, afm_arena *arena, size_t count, const char *field);
 uint8_t *afm_read_u8_array(afm_reader *r, afm_arena *arena, size_t count, const char *field);
+/* `count` runs (u32 start, u32 length) into the arena (NULL when measuring):
+ * non-empty, ascending, disjoint, within [0, limit). `what` prefixes error
+ * messages ("target 3 (FAP 12)"), `limit_name` names the limit; *total gets
+ * the sum of the lengths. */
+afm_run *afm_read_runs(afm_reader *r, afm_arena *arena, uint32_t count, uint32_t limit,
+                       const char *what, const char *limit_name, uint64_t *total);
 /* Records an error at the cursor (first one wins) and returns it. */
 afm_result afm_fail(afm_reader *r, afm_result result, const char *format, ...)
 #if defined(__GNUC__)
@@ -113,15 +119,25 @@ afm_result afm_rigids_decode(const uint8_t *raw, size_t size, uint64_t file_offs
                              uint32_t part_count, afm_arena *arena, uint32_t *count,
                              afm_rigid **rigids, afm_diag *diag);
 afm_result afm_rigids_encode(const afm_rigid *rigids, uint32_t count, afm_writer *w);
+afm_result afm_lift_decode(const uint8_t *raw, size_t size, uint64_t file_offset,
+                           uint32_t vertex_count, afm_arena *arena, afm_lift **lift,
+                           afm_diag *diag);
+afm_result afm_lift_encode(const afm_lift *lift, afm_writer *w);
+/* The cross-chunk rules of LIFT on decoded targets: no normal deltas, no
+ * run over a bound vertex. */
+afm_result afm_lift_check_targets(const afm_lift *lift, const afm_target *targets,
+                                  uint32_t count, uint64_t file_offset, afm_diag *diag);
 
 /* Decoders of the public chunk API, with the payload's file offset for
  * messages and a caller-provided arena. */
 afm_result afm_geometry_decode_at(const uint8_t *raw, size_t size, uint64_t file_offset,
                                   afm_arena *arena, afm_geometry *geometry, afm_diag *diag);
 afm_result afm_geometry_encode_to(const afm_geometry *geometry, afm_writer *w);
+/* Runs index [0, vertex_count + control_count) (the caller checked the sum
+ * fits 32 bits). */
 afm_result afm_targets_decode_at(const uint8_t *raw, size_t size, uint64_t file_offset,
-                                 uint32_t vertex_count, afm_arena *arena, uint32_t *count,
-                                 afm_target **targets, afm_diag *diag);
+                                 uint32_t vertex_count, uint32_t control_count, afm_arena *arena,
+                                 uint32_t *count, afm_target **targets, afm_diag *diag);
 afm_result afm_targets_encode_to(const afm_target *targets, uint32_t count, afm_writer *w);
 
 #endif /* AFM_INTERNAL_H */

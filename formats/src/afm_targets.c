@@ -1,4 +1,5 @@
 /* MTGT chunk: sparse quantised morph targets (formats/afm.md). */
+#include <stdio.h>
 #include <string.h>
 
 #include "afm_internal.h"
@@ -22,7 +23,8 @@ static const char *kind_text(uint8_t kind) {
 }
 
 afm_result afm_targets_decode_at(const uint8_t *raw, size_t size, uint64_t file_offset,
-                                 uint32_t vertex_count, afm_arena *arena, uint32_t *count_out,
+                                 uint32_t vertex_count, uint32_t control_count, afm_arena *arena,
+                                 uint32_t *count_out,
                                  afm_target **targets_out, afm_diag *diag) {
   afm_reader r;
   afm_target *targets;
@@ -38,7 +40,6 @@ afm_result afm_targets_decode_at(const uint8_t *raw, size_t size, uint64_t file_
   for (i = 0; i < count; ++i) {
     afm_target t;
     afm_run *runs;
-    uint32_t k, end = 0;
     uint64_t total = 0;
     memset(&t, 0, sizeof t);
     t.kind = afm_read_u8(&r, "target.kind");
@@ -69,23 +70,12 @@ afm_result afm_targets_decode_at(const uint8_t *raw, size_t size, uint64_t file_
       return afm_fail(&r, AFM_ERR_TRUNCATED, "target %lu: %lu runs and %lu deltas cannot fit",
                       (unsigned long)i, (unsigned long)t.run_count,
                       (unsigned long)t.delta_count);
-    runs = (afm_run *)afm_arena_take(arena, afm_mul_size(t.run_count, sizeof *runs));
-    for (k = 0; k < t.run_count; ++k) {
-      afm_run run;
-      run.start = afm_read_u32(&r, "run.start");
-      run.length = afm_read_u32(&r, "run.length");
+    {
+      char what[48];
+      sprintf(what, "target %lu (%s %u)", (unsigned long)i, kind_text(t.kind), (unsigned)t.number);
+      runs = afm_read_runs(&r, arena, t.run_count, vertex_count + control_count, what,
+                           control_count ? "vertex_count + control_count" : "vertex_count", &total);
       if (r.error != AFM_OK) return r.error;
-      if (run.length == 0 || (k > 0 && run.start < end) || run.start > vertex_count ||
-          run.length > vertex_count - run.start)
-        return afm_fail(&r, AFM_ERR_RANGE,
-                        "target %lu (%s %u): run %lu [%lu, +%lu) is empty, overlaps the "
-                        "previous run or passes vertex_count %lu",
-                        (unsigned long)i, kind_text(t.kind), (unsigned)t.number,
-                        (unsigned long)k, (unsigned long)run.start, (unsigned long)run.length,
-                        (unsigned long)vertex_count);
-      end = run.start + run.length;
-      total += run.length;
-      if (runs) runs[k] = run;
     }
     if (total != t.delta_count)
       return afm_fail(&r, AFM_ERR_RANGE, "target %lu: runs cover %lu vertices, delta_count is %lu",
@@ -121,7 +111,7 @@ afm_result afm_targets_decode(const uint8_t *raw, size_t size, uint32_t vertex_c
   arena.base = (uint8_t *)buffer;
   arena.size = buffer_size;
   arena.used = 0;
-  res = afm_targets_decode_at(raw, size, 0, vertex_count, &arena, &n, &t, diag);
+  res = afm_targets_decode_at(raw, size, 0, vertex_count, 0, &arena, &n, &t, diag);
   if (bytes) *bytes = arena.used;
   if (target_count) *target_count = n;
   if (targets) *targets = t;

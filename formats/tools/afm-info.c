@@ -13,7 +13,8 @@ static void usage(FILE *out) {
           "usage: afm-info [--fdps] [--targets] FILE.afm\n"
           "\n"
           "Prints an Animatable Face Model's chunks (kind, encoding, size, CRC), model\n"
-          "name, FAPU, parts, quantisation, morph targets and rigid parts.\n"
+          "name, FAPU, parts, quantisation, morph targets, control points (LIFT) and\n"
+          "rigid parts.\n"
           "\n"
           "  --fdps      list every feature point\n"
           "  --targets   list every morph target (default: a summary per kind)\n"
@@ -130,8 +131,13 @@ static void print_targets(const afm_doc *d, int list) {
          " deltas int16 in position quanta\n",
          (unsigned long)d->target_count, (unsigned long)counts[0], (unsigned long)counts[1],
          (unsigned long)counts[2], deltas, runs);
+  if (d->lift)
+    printf("control points (LIFT): %lu, driving %lu vertices in %lu run(s); target entries from %lu on are "
+           "controls\n",
+           (unsigned long)d->lift->control_count, (unsigned long)d->lift->bound_count,
+           (unsigned long)d->lift->run_count, (unsigned long)d->geometry.vertex_count);
   if (!list) return;
-  printf("  kind        no  name                          reference   runs  vertices  normals\n");
+  printf("  kind        no  name                          reference   runs  entries   normals\n");
   for (i = 0; i < d->target_count; ++i) {
     const afm_target *t = &d->targets[i];
     printf("  %-10s  %2u  %-28s  %9ld  %5lu  %8lu  %s\n", target_kind(t->kind), t->number,

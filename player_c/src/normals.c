@@ -220,7 +220,7 @@ void afm_normals_recompute(afm_player *p) {
   /* Stale: the corners of every face with a moved corner, each face once
    * (stamp 2n - 1: "corners marked"; 2n: "normal added"). */
   for (i = 0; i < p->dirty_count; ++i)
-    for (v = p->dirty[i].start; v < p->dirty[i].end; ++v)
+    for (v = p->dirty[i].start; v < p->dirty[i].end && v < p->vertex_count; ++v) /* not controls */
       for (k = p->ring_start[v]; k < p->ring_start[v + 1]; ++k) {
         uint32_t f = p->ring[k];
         const uint32_t *t = tri + 3 * (size_t)f;

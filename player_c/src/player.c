@@ -10,8 +10,9 @@ static int recomputes_normals(uint32_t flags) {
   return !(flags & (AFM_PLAYER_NORMAL_DELTAS | AFM_PLAYER_NO_NORMALS));
 }
 
+/* Runs of all targets and of the lift: what bounds the pose's spans. */
 static uint64_t total_runs(const afm_doc *doc) {
-  uint64_t n = 0;
+  uint64_t n = doc->lift ? doc->lift->run_count : 0;
   uint32_t i;
   for (i = 0; i < doc->target_count; ++i) n += doc->targets[i].run_count;
   return n;
@@ -21,7 +22,8 @@ static uint64_t total_runs(const afm_doc *doc) {
  * or 0 when it passes size_t. */
 static size_t layout(afm_player *p, uint8_t *base, const afm_doc *doc, uint32_t flags) {
   const uint64_t V = doc->geometry.vertex_count, T = doc->geometry.triangle_count,
-                 N = doc->target_count, R = total_runs(doc), P = doc->geometry.part_count;
+                 N = doc->target_count, R = total_runs(doc), P = doc->geometry.part_count,
+                 E = afm_doc_entry_count(doc);
   uint64_t at = align8(sizeof(afm_player));
 #define TAKE(field, type, count)                                     \
   do {                                                               \
@@ -31,16 +33,16 @@ static size_t layout(afm_player *p, uint8_t *base, const afm_doc *doc, uint32_t 
   TAKE(max_delta, int32_t, N);
   TAKE(weight_scratch, int32_t, 2 * N);
   TAKE(weights, afm_q12, N);
-  TAKE(acc, int32_t, 3 * V);
-  TAKE(moved, uint8_t, V);
-  TAKE(dirty, afm_span, R);
+  TAKE(acc, int32_t, 3 * E);
+  TAKE(moved, uint8_t, E);
+  TAKE(dirty, afm_span, R + 1);
   TAKE(restore, afm_span, R + 4 * P + 1);
   TAKE(positions, int32_t, 3 * V);
   TAKE(normals, afm_q14, 3 * V);
   if (flags & AFM_PLAYER_NO_NORMALS) {
     /* positions only */
   } else if (flags & AFM_PLAYER_NORMAL_DELTAS) {
-    TAKE(normal_acc, int32_t, 3 * V);
+    TAKE(normal_acc, int32_t, 3 * E);
   } else {
     TAKE(ring_start, uint32_t, V + 1);
     TAKE(ring, uint32_t, 3 * T);
@@ -62,7 +64,7 @@ static afm_result check_doc(const afm_doc *doc) {
     return AFM_ERR_ARGUMENT;
   /* The kernels rely on arithmetic right shifts of negative values. */
   if ((-5 >> 1) != -3) return AFM_ERR_STATE;
-  if (total_runs(doc) > 0x3FFFFFFFu) return AFM_ERR_LIMIT;
+  if (total_runs(doc) > 0x3FFFFFFFu || afm_doc_entry_count(doc) > 0x3FFFFFFFu) return AFM_ERR_LIMIT;
   return afm_rigids_check(doc);
 }
 
@@ -93,11 +95,12 @@ afm_result afm_player_init(const afm_doc *doc, const afm_player_options *options
   p->doc = doc;
   p->flags = flags;
   p->vertex_count = doc->geometry.vertex_count;
+  p->entry_count = (uint32_t)afm_doc_entry_count(doc);
   p->target_count = doc->target_count;
   p->triangle_count = doc->geometry.triangle_count;
   layout(p, (uint8_t *)buffer, doc, flags);
   afm_weights_init(p);
-  memset(p->moved, 0, p->vertex_count); /* the caller's buffer may hold anything */
+  memset(p->moved, 0, p->entry_count); /* the caller's buffer may hold anything */
   if (recomputes_normals(flags)) afm_normals_init(p);
   afm_neutral_outputs(p, 0, p->vertex_count);
   afm_blend_reset(p, kWeightBits);

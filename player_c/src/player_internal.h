@@ -33,20 +33,24 @@ struct afm_player {
   int32_t *weight_scratch; /* [2 targets] */
   afm_q12 *weights;        /* [targets] */
 
-  /* blend.c. Between poses, acc == neutral << acc_shift everywhere but in
-   * the spans `dirty`, which the next pose restores first. */
+  /* blend.c. Accumulators hold entries: the V vertices, then the AFM's
+   * C control points (LIFT; E = V + C), whose neutral value is 0. Between
+   * poses, acc == neutral << acc_shift everywhere but in the spans `dirty`,
+   * which the next pose restores first. */
+  uint32_t entry_count; /* E */
   int acc_shift;
-  int32_t *acc;        /* [3V] planar: x[V], y[V], z[V] */
-  int32_t *normal_acc; /* [3V] planar, AFM_PLAYER_NORMAL_DELTAS only */
-  uint8_t *moved;        /* [V] marks of this pose's morphed vertices; all 0 between poses */
-  afm_span *dirty;       /* [all runs] disjoint spans the morph targets moved, ascending */
+  int32_t *acc;        /* [3E] planar: x[E], y[E], z[E] */
+  int32_t *normal_acc; /* [3E] planar, AFM_PLAYER_NORMAL_DELTAS only */
+  uint8_t *moved;        /* [E] marks of this pose's morphed entries; all 0 between poses */
+  afm_span *dirty;       /* [all runs + lift runs + 1] disjoint entry spans the pose
+                            moved, ascending (may reach past V: controls) */
   uint32_t dirty_count;
 
   /* Outputs, and what the last pose changed in them: the spans in
    * `restore` (morphed vertices and rigid parts) and the `stale` normals. */
   int32_t *positions; /* [3V] interleaved quanta */
   afm_q14 *normals;   /* [3V] interleaved Q14 */
-  afm_span *restore;  /* [all runs + 4 P] */
+  afm_span *restore;  /* [all runs + lift runs + 4 P + 1] */
   uint32_t restore_count, restore_capacity;
 
   /* normals.c (recomputation mode). */

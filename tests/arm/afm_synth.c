@@ -1,6 +1,6 @@
 /* afm_synth: gives a neutral AFM synthetic morph targets and rigid parts.
  *
- *   afm_synth IN.afm OUT.afm
+ *   afm_synth [--lift] IN.afm OUT.afm
  *
  * A host-side test helper (not part of the core). Where afm-import
  * --analytic makes plausible stand-in targets, this one aims at coverage of
@@ -17,6 +17,11 @@
  *     shape) on every third bidirectional FAP;
  *   - visemes 1..14 and expressions 1..6 (reference 63): mixes of bumps around
  *     the lips, mouth corners and eyebrows.
+ * --lift: the targets move control points instead (formats/afm.md, LIFT):
+ * control c samples skin vertex 2c, and skin vertex i is bound to controls
+ * i/2, i/2 + 1 and i/2 + 5 (wrapped) with weights that vary from vertex to
+ * vertex, all three nonzero on most. Not a plausible face: coverage of the
+ * lift's arithmetic (no normal deltas then, as LIFT requires).
  * Rigid parts: both eyeballs (FAPs 23..28; the left eye's axes turned 5
  * degrees), the jaw (FAPs 3, 14, 15 on the lower teeth and tongue) and the
  * head (FAPs 48..50, every part), as formats/afm.md describes them.
@@ -357,6 +362,59 @@ static uint32_t make_rigids(const afm_doc *in, afm_rigid *out) {
   return n;
 }
 
+/* --lift: every target's skin deltas become deltas of C = ceil(skin / 2)
+ * control points (see the header comment). */
+static void lift_targets(synth *s, afm_lift *lift, afm_run *lift_run, uint32_t *c[3], uint16_t *w[2]) {
+  const uint32_t V = s->in->geometry.vertex_count, first = s->skin->first_vertex, n = s->skin->vertex_count;
+  const uint32_t C = (n + 1) / 2;
+  int16_t *dense = (int16_t *)xcalloc(3 * (size_t)n, sizeof *dense);
+  uint32_t t, i, r, k;
+  for (k = 0; k < 3; ++k) c[k] = (uint32_t *)xcalloc(n, sizeof(uint32_t));
+  for (k = 0; k < 2; ++k) w[k] = (uint16_t *)xcalloc(n, sizeof(uint16_t));
+  for (i = 0; i < n; ++i) {
+    uint32_t a = (uint32_t)(((uint64_t)i * 2654435761u) >> 8) % 12288u, b = (i * 40503u) % 12288u;
+    c[0][i] = i / 2;
+    c[1][i] = (i / 2 + 1) % C;
+    c[2][i] = (i / 2 + 5) % C;
+    w[0][i] = (uint16_t)(i % 2 ? a + 8192 : a); /* w1 + w2 <= 32766: w0 > 0 */
+    w[1][i] = (uint16_t)b;
+  }
+  for (t = 0; t < s->target_count; ++t) {
+    afm_target *tg = &s->targets[t];
+    int16_t *d[3];
+    memset(dense, 0, 3 * (size_t)n * sizeof *dense);
+    for (r = 0, k = 0; r < tg->run_count; ++r)
+      for (i = 0; i < tg->runs[r].length; ++i, ++k) {
+        const uint32_t v = tg->runs[r].start + i - first;
+        dense[3 * v] = tg->dx[k], dense[3 * v + 1] = tg->dy[k], dense[3 * v + 2] = tg->dz[k];
+      }
+    for (k = 0; k < 3; ++k) d[k] = (int16_t *)xcalloc(C, sizeof(int16_t));
+    for (i = 0; i < C; ++i)
+      for (k = 0; k < 3; ++k) d[k][i] = dense[3 * (size_t)(2 * i) + k];
+    free((void *)tg->runs);
+    free((void *)tg->dx), free((void *)tg->dy), free((void *)tg->dz);
+    free((void *)tg->nx), free((void *)tg->ny), free((void *)tg->nz);
+    tg->flags = 0;
+    tg->nx = tg->ny = tg->nz = NULL;
+    tg->run_count = 1;
+    tg->runs = (afm_run *)xcalloc(1, sizeof(afm_run));
+    ((afm_run *)tg->runs)->start = V;
+    ((afm_run *)tg->runs)->length = C;
+    tg->delta_count = C;
+    tg->dx = d[0], tg->dy = d[1], tg->dz = d[2];
+  }
+  free(dense);
+  lift_run->start = first;
+  lift_run->length = n;
+  memset(lift, 0, sizeof *lift);
+  lift->control_count = C;
+  lift->run_count = 1;
+  lift->runs = lift_run;
+  lift->bound_count = n;
+  lift->c0 = c[0], lift->c1 = c[1], lift->c2 = c[2];
+  lift->w1 = w[0], lift->w2 = w[1];
+}
+
 int main(int argc, char **argv) {
   uint8_t *data, *out;
   size_t size, out_size;
@@ -367,9 +425,14 @@ int main(int argc, char **argv) {
   afm_rigid rigids[4];
   afm_result r;
   synth s;
-  int skin, k;
+  afm_lift lift;
+  afm_run lift_run;
+  uint32_t *lift_c[3] = {NULL, NULL, NULL};
+  uint16_t *lift_w[2] = {NULL, NULL};
+  int skin, k, with_lift = argc == 4 && strcmp(argv[1], "--lift") == 0;
+  if (with_lift) --argc, ++argv;
   if (argc != 3) {
-    fprintf(stderr, "usage: afm_synth IN.afm OUT.afm\n");
+    fprintf(stderr, "usage: afm_synth [--lift] IN.afm OUT.afm\n");
     return 2;
   }
   memset(&diag, 0, sizeof diag);
@@ -397,6 +460,10 @@ int main(int argc, char **argv) {
   doc.targets = s.targets;
   doc.rigid_count = make_rigids(in, rigids);
   doc.rigids = rigids;
+  if (with_lift) {
+    lift_targets(&s, &lift, &lift_run, lift_c, lift_w);
+    doc.lift = &lift;
+  }
   memset(&wo, 0, sizeof wo);
   wo.diag = &diag;
   r = afm_doc_write(&doc, &wo, &out, &out_size);
@@ -422,6 +489,8 @@ int main(int argc, char **argv) {
     free((void *)rigids[k].controls);
   }
   for (k = 0; k < 6; ++k) free(s.acc[k]);
+  for (k = 0; k < 3; ++k) free(lift_c[k]);
+  for (k = 0; k < 2; ++k) free(lift_w[k]);
   free(s.weight);
   afm_free(NULL, out);
   afm_free(NULL, in);

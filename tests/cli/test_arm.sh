@@ -6,7 +6,8 @@
 # as host-O0, host-O2 and host-O3 (sanitized in config=sanitize); every
 # per-frame line must match host-O2's. Inputs: the reference head (afm-headgen + afm-import,
 # raw profile), the same head with synthetic morph targets and rigid parts
-# (afm_synth), a smaller head with them for the long streams, the FAP files
+# (afm_synth), a smaller head with them for the long streams and once more
+# with control points (afm_synth --lift: the LIFT kernel), the FAP files
 # in ../shared/data/fap when present, and a synthetic stream written here.
 # Also checks that the ARM objects use no FPU: no VFP/NEON instructions, no
 # FP attributes, soft-float ABI; and that the core (formats/src and
@@ -74,6 +75,7 @@ if ! "$bin/afm-headgen" -o "$tmp/head.obj" --fdp "$tmp/head.fdp" >/dev/null ||
    ! "$bin/afm-headgen" --vertices 2000 -o "$tmp/small.obj" --fdp "$tmp/small.fdp" >/dev/null ||
    ! "$bin/afm-import" "$tmp/small.obj" "$tmp/small.fdp" -o "$tmp/small.afm" >/dev/null ||
    ! "$arm/afm_synth" "$tmp/small.afm" "$tmp/small-synth.afm" >/dev/null ||
+   ! "$arm/afm_synth" --lift "$tmp/small.afm" "$tmp/small-lift.afm" >/dev/null ||
    ! "$bin/afm-pack" --draco "$tmp/small-synth.afm" "$tmp/small-draco.afm" >/dev/null; then
   echo "FAIL: making the test heads"
   exit 1
@@ -156,6 +158,7 @@ check_case small "$tmp/small-synth.afm" "$tmp/synthetic.fap" $shared_faps
 check_case head "$tmp/head.afm" "$tmp/synthetic.fap"
 check_case head-synth "$tmp/head-synth.afm" "$tmp/synthetic.fap"
 check_case draco "$tmp/small-draco.afm"
+check_case lift "$tmp/small-lift.afm" "$tmp/synthetic.fap"
 
 # ---- the outputs say what they should ------------------------------------------
 out="$tmp/small.host-O2.txt"
@@ -185,6 +188,11 @@ if grep -q '^pose ' "$out"; then
   [ "$distinct" -ge 50 ] || fail "only $distinct distinct poses over the streams"
   distinct=$(grep '^frame' "$tmp/head-synth.host-O2.txt" | grep -o 'pose=[0-9a-f]*' | sort -u | wc -l)
   [ "$distinct" -ge 50 ] || fail "only $distinct distinct poses of the synthetic stream on the reference head"
+  # Control points (LIFT): the lifted head moves through the whole stream.
+  distinct=$(grep '^frame' "$tmp/lift.host-O2.txt" | grep -o 'pose=[0-9a-f]*' | sort -u | wc -l)
+  [ "$distinct" -ge 50 ] || fail "only $distinct distinct poses of the synthetic stream on the lifted head"
+  grep '^frame' "$tmp/lift.host-O2.txt" | grep -o 'pose=[0-9a-f]*' >"$tmp/lift.poses"
+  [ "$(grep -c . "$tmp/lift.poses")" -ge 60 ] || fail "the lifted head played fewer than 60 frames"
 fi
 
 finish "$cases cases, $lines lines each identical on $variants; FAP reader: $fap_reader, player: $player"

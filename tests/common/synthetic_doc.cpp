@@ -15,12 +15,20 @@ namespace {
 
 int16_t q(double x) { return static_cast<int16_t>(std::lround(std::clamp(x, -32767.0, 32767.0))); }
 
+// A target entry: its index (vertex, or V + control) and where the field is
+// sampled.
+struct Entry {
+  uint32_t index;
+  double x, y, z;
+};
+
 void add_target(SyntheticDoc &s, uint8_t kind, uint8_t number, int32_t reference, bool normals,
-                double (*field)(double, double, double, int), size_t vertex_count) {
+                double (*field)(double, double, double, int), const std::vector<Entry> &entries) {
   SyntheticDoc::Target t;
-  // Runs over vertices where the field is nonzero; merged across 1-vertex gaps.
-  for (size_t i = 0; i < vertex_count; ++i) {
-    double x = s.px[i], y = s.py[i], z = s.pz[i];
+  // Runs over entries where the field is nonzero.
+  for (const Entry &e : entries) {
+    const uint32_t i = e.index;
+    double x = e.x, y = e.y, z = e.z;
     int16_t d[3] = {q(field(x, y, z, 0)), q(field(x, y, z, 1)), q(field(x, y, z, 2))};
     if (d[0] == 0 && d[1] == 0 && d[2] == 0) continue;
     if (!t.runs.empty() && t.runs.back().start + t.runs.back().length == i) {
@@ -151,12 +159,53 @@ const afm_doc *make_synthetic_doc(SyntheticDoc &s, const SyntheticOptions &o) {
   s.parts = {skin, eye};
 
   const size_t V = s.px.size();
-  add_target(s, AFM_TARGET_FAP, 3, 1024, o.normal_deltas, jaw_field, V);
-  add_target(s, AFM_TARGET_FAP, 12, 512, false, smile_field, V);
-  add_target(s, AFM_TARGET_FAP, 31, 256, o.normal_deltas, brow_field, V);
-  add_target(s, AFM_TARGET_FAP, 31, -256, false, smile_field, V);  // negative side of FAP 31
-  add_target(s, AFM_TARGET_VISEME, 1, 63, false, jaw_field, V);
-  add_target(s, AFM_TARGET_EXPRESSION, 1, 63, false, smile_field, V);
+  std::vector<Entry> entries;
+  const bool normal_deltas = o.normal_deltas && !o.lift;
+  if (!o.lift) {
+    for (uint32_t i = 0; i < V; ++i) entries.push_back({i, double(s.px[i]), double(s.py[i]), double(s.pz[i])});
+  } else {
+    // Controls: skin rows and columns 0, 2, 4, ... (their positions sample
+    // the fields); skin vertex (r, c) binds to the coarse cell around it,
+    // split as the skin's cells are (a b e / a e d), clamped at the far edges.
+    const int CR = (R + 1) / 2, CC = (C + 1) / 2;
+    auto control = [&](int cr, int cc) { return uint32_t(cr * CC + cc); };
+    for (uint32_t i = skin_v; i < V; ++i) entries.push_back({i, double(s.px[i]), double(s.py[i]), double(s.pz[i])});
+    for (int cr = 0; cr < CR; ++cr)
+      for (int cc = 0; cc < CC; ++cc) {
+        const size_t f = size_t(2 * cr) * C + size_t(2 * cc);
+        entries.push_back({uint32_t(V) + control(cr, cc), double(s.px[f]), double(s.py[f]), double(s.pz[f])});
+      }
+    for (int r = 0; r < R; ++r)
+      for (int c = 0; c < C; ++c) {
+        const int cr = std::min(r / 2, CR - 2), cc = std::min(c / 2, CC - 2);
+        const double v = std::min(1.0, (r - 2 * cr) / 2.0), u = std::min(1.0, (c - 2 * cc) / 2.0);
+        const uint32_t a = control(cr, cc), b = control(cr, cc + 1), d = control(cr + 1, cc),
+                       e = control(cr + 1, cc + 1);
+        uint32_t corner[3];
+        double w[3];
+        if (u >= v) {
+          corner[0] = a, corner[1] = b, corner[2] = e, w[1] = u - v, w[2] = v;
+        } else {
+          corner[0] = a, corner[1] = e, corner[2] = d, w[1] = u, w[2] = v - u;
+        }
+        for (int k = 0; k < 3; ++k) s.lift_c[k].push_back(corner[k]);
+        for (int k = 0; k < 2; ++k) s.lift_w[k].push_back(uint16_t(std::lround(w[k + 1] * 32768)));
+      }
+    s.lift_runs = {{0, skin_v}};
+    afm_lift &l = s.lift;
+    l.control_count = uint32_t(CR * CC);
+    l.run_count = 1;
+    l.runs = s.lift_runs.data();
+    l.bound_count = skin_v;
+    l.c0 = s.lift_c[0].data(), l.c1 = s.lift_c[1].data(), l.c2 = s.lift_c[2].data();
+    l.w1 = s.lift_w[0].data(), l.w2 = s.lift_w[1].data();
+  }
+  add_target(s, AFM_TARGET_FAP, 3, 1024, normal_deltas, jaw_field, entries);
+  add_target(s, AFM_TARGET_FAP, 12, 512, false, smile_field, entries);
+  add_target(s, AFM_TARGET_FAP, 31, 256, normal_deltas, brow_field, entries);
+  add_target(s, AFM_TARGET_FAP, 31, -256, false, smile_field, entries);  // negative side of FAP 31
+  add_target(s, AFM_TARGET_VISEME, 1, 63, false, jaw_field, entries);
+  add_target(s, AFM_TARGET_EXPRESSION, 1, 63, false, smile_field, entries);
   for (size_t i = 0; i < s.targets.size(); ++i) {
     SyntheticDoc::Target &t = s.target_data[i];
     afm_target &at = s.targets[i];
@@ -215,6 +264,7 @@ const afm_doc *make_synthetic_doc(SyntheticDoc &s, const SyntheticOptions &o) {
   d.targets = s.targets.data();
   d.rigid_count = static_cast<uint32_t>(s.rigids.size());
   d.rigids = s.rigids.data();
+  if (o.lift) d.lift = &s.lift;
   return &s.doc;
 }
 
@@ -290,6 +340,17 @@ std::string compare_docs(const afm_doc &a, const afm_doc &b) {
       return "target deltas " + std::to_string(i);
     if (!same(x.nx, y.nx, n) || !same(x.ny, y.ny, n) || !same(x.nz, y.nz, n))
       return "target normal deltas " + std::to_string(i);
+  }
+  if (!a.lift != !b.lift) return "lift presence";
+  if (a.lift) {
+    const afm_lift &x = *a.lift, &y = *b.lift;
+    const size_t n = x.bound_count;
+    if (x.control_count != y.control_count || x.run_count != y.run_count || x.bound_count != y.bound_count)
+      return "lift counts";
+    for (uint32_t k = 0; k < x.run_count; ++k)
+      if (x.runs[k].start != y.runs[k].start || x.runs[k].length != y.runs[k].length) return "lift runs";
+    if (!same(x.c0, y.c0, n) || !same(x.c1, y.c1, n) || !same(x.c2, y.c2, n)) return "lift controls";
+    if (!same(x.w1, y.w1, n) || !same(x.w2, y.w2, n)) return "lift weights";
   }
   if (a.rigid_count != b.rigid_count) return "rigid_count";
   for (uint32_t i = 0; i < a.rigid_count; ++i) {

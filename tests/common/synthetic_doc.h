@@ -28,6 +28,11 @@ struct SyntheticDoc {
   std::vector<uint16_t> rigid_parts;
   std::vector<afm_control> controls;
   std::vector<afm_rigid> rigids;
+  // With SyntheticOptions::lift.
+  std::vector<afm_run> lift_runs;
+  std::vector<uint32_t> lift_c[3];
+  std::vector<uint16_t> lift_w[2];
+  afm_lift lift{};
   afm_doc doc{};
 };
 
@@ -39,6 +44,11 @@ struct SyntheticOptions {
   bool normal_deltas = true;
   bool shuffle_triangles = false;  // write triangles in a non-canonical order
   bool loose_vertex = false;       // drop the skin's triangles using vertex 7 (unreferenced)
+  // Control points (LIFT): the skin's every other row and column are the
+  // controls, every skin vertex is bound to a coarse triangle of them, and
+  // the targets move the controls (the eye keeps vertex deltas). No normal
+  // deltas then.
+  bool lift = false;
 };
 
 // Fills `s` and returns &s.doc (valid while `s` lives and is not moved).

@@ -603,6 +603,22 @@ TEST(FapSynthesis, TheSameOnAnyNumberOfThreads) {
   for (size_t i = 0; i < one->jaw.controls.size(); ++i) EXPECT_EQ(one->jaw.controls[i].gain, three->jaw.controls[i].gain);
 }
 
+using DocPtr = std::unique_ptr<afm_doc, void (*)(afm_doc *)>;
+
+// The content encoded (draco profile) and read back; null, with a test
+// failure, when either step fails.
+DocPtr encoded_doc(const AfmContent &content) {
+  DocPtr none(nullptr, [](afm_doc *) {});
+  Expected<std::vector<uint8_t>> bytes = encode_afm(content, AFM_PROFILE_DRACO);
+  EXPECT_TRUE(bytes.is_ok()) << bytes.status().message();
+  if (!bytes) return none;
+  afm_read_options ro{};
+  ro.draco = afm_draco_codec();
+  afm_doc *doc = nullptr;
+  EXPECT_EQ(afm_doc_read_alloc(bytes->data(), bytes->size(), &ro, nullptr, &doc), AFM_OK);
+  return DocPtr(doc, [](afm_doc *d) { afm_free(nullptr, d); });
+}
+
 // The simulation mesh (anatomy/sim_mesh.h) against the skin itself: the
 // 1k head's targets for FAPs 12 and 33 made on an 800-vertex copy of its
 // skin and carried back agree with those made on the whole skin. The FDP
@@ -651,6 +667,43 @@ TEST(FapSynthesis, TargetsMadeOnACoarserSimulationMeshMatchTheSkins) {
     const double largest_made = made->displacement[skin].rowwise().norm().maxCoeff();
     EXPECT_LT(largest_made, 1.25 * largest_full) << "FAP " << fap;
     EXPECT_LT(diff, 0.5 * field) << "FAP " << fap;
+  }
+
+  // The AFM stores the simulation mesh's motion on control points (LIFT):
+  // every skin vertex is bound, and its lifted delta is the builder's within
+  // half a quantum (the controls' rounding) plus the Q15 weights' rounding
+  // (at most 2^-15 of each corner's delta, 3 corners).
+  ASSERT_EQ(syn->lift.control_count, 800);
+  const AfmContent content = fap_afm_content(b.head.scene, b.head.fdps, *m, *syn);
+  const DocPtr hold = encoded_doc(content);
+  const afm_doc *doc = hold.get();
+  ASSERT_NE(doc, nullptr);
+  ASSERT_NE(doc->lift, nullptr);
+  EXPECT_EQ(doc->lift->control_count, 800u);
+  const afm_part &skin_part = doc->geometry.parts[skin];
+  ASSERT_EQ(doc->lift->runs[0].start, skin_part.first_vertex);
+  ASSERT_GE(doc->lift->runs[0].length, skin_part.vertex_count);
+  const RenderVertices rv = afm_render_vertices(content);
+  const double step = doc->geometry.step;
+  std::vector<int32_t> q15(3 * size_t(afm_doc_entry_count(doc)));
+  for (uint32_t i = 0; i < doc->target_count; ++i) {
+    const afm_target &at = doc->targets[i];
+    const MorphTarget *mt = nullptr;
+    for (const MorphTarget &t : syn->targets)
+      if (t.number == at.number && t.reference == at.reference) mt = &t;
+    ASSERT_TRUE(mt);
+    ASSERT_EQ(afm_target_expand(doc, &at, q15.data()), AFM_OK);
+    const double corner_max = mt->controls.cwiseAbs().maxCoeff() / step;
+    const double bound = 0.5 + 3 * corner_max / 32768 + 1e-6;
+    double worst = 0;
+    const Eigen::MatrixXd &D = mt->displacement[skin];
+    for (Eigen::Index w = 0; w < D.rows(); ++w)
+      for (uint32_t v : rv.copies[skin][size_t(w)])
+        for (int k = 0; k < 3; ++k)
+          worst = std::max(worst, std::abs(q15[3 * size_t(v) + size_t(k)] / 32768.0 - D(w, k) / step));
+    EXPECT_LE(worst, bound) << "FAP " << int(at.number);
+    std::printf("FAP %d: lifted AFM deltas against the builder's: worst %.3f quanta (bound %.3f)\n", int(at.number),
+                worst, bound);
   }
 }
 
@@ -769,13 +822,9 @@ TEST(FapSynthesis, TheAfmHoldsTheTargetsAndTheJaw) {
   const FapSynthesis &s = synthesis();
   ASSERT_FALSE(s.jaw.parts.empty());
   const AfmContent c = fap_afm_content(b.head.scene, b.head.fdps, b.model, s);
-  Expected<std::vector<uint8_t>> bytes = encode_afm(c, AFM_PROFILE_DRACO);
-  ASSERT_TRUE(bytes.is_ok()) << bytes.status().message();
-  afm_read_options ro{};
-  ro.draco = afm_draco_codec();
-  afm_doc *doc = nullptr;
-  ASSERT_EQ(afm_doc_read_alloc(bytes->data(), bytes->size(), &ro, nullptr, &doc), AFM_OK);
-  std::unique_ptr<afm_doc, void (*)(afm_doc *)> hold(doc, [](afm_doc *d) { afm_free(nullptr, d); });
+  const DocPtr hold = encoded_doc(c);
+  const afm_doc *doc = hold.get();
+  ASSERT_NE(doc, nullptr);
   ASSERT_EQ(doc->target_count, s.targets.size());
   for (uint32_t i = 0; i < doc->target_count; ++i) {
     bool found = false;

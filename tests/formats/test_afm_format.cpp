@@ -63,6 +63,33 @@ int chunk_encoding(const std::vector<uint8_t> &f, uint32_t kind) {
   return -1;
 }
 
+// A way to spoil a valid synthetic document, and what the writer must say.
+struct SpoilCase {
+  const char *what;
+  void (*spoil)(SyntheticDoc &);
+  const char *message;
+};
+
+// Each case spoils a fresh synthetic document (options `o`); the writer,
+// which validates as the reader does, must refuse it, write nothing and
+// name the problem.
+void expect_writer_refuses(const SpoilCase *cases, size_t count, const afmtest::SyntheticOptions &o) {
+  for (size_t i = 0; i < count; ++i) {
+    const SpoilCase &c = cases[i];
+    SyntheticDoc s;
+    make_synthetic_doc(s, o);
+    c.spoil(s);
+    afm_write_options wo{};
+    afm_diag diag{};
+    wo.diag = &diag;
+    uint8_t *out = nullptr;
+    size_t n = 0;
+    EXPECT_NE(afm_doc_write(&s.doc, &wo, &out, &n), AFM_OK) << c.what;
+    EXPECT_EQ(out, nullptr) << c.what;
+    EXPECT_NE(std::string(diag.message).find(c.message), std::string::npos) << c.what << ": " << diag.message;
+  }
+}
+
 }  // namespace
 
 TEST(AfmFormat, RawRoundTripKeepsEveryField) {
@@ -251,12 +278,7 @@ TEST(AfmFormat, UnknownOptionalChunkIsSkippedRequiredRefused) {
 }
 
 TEST(AfmFormat, WriterRefusesInvalidDocuments) {
-  struct Case {
-    const char *what;
-    void (*spoil)(SyntheticDoc &);
-    const char *message;
-  };
-  const Case cases[] = {
+  const SpoilCase cases[] = {
       {"triangle outside its part", [](SyntheticDoc &s) { s.tris[5] = s.parts[0].vertex_count + 3; },
        "outside the part"},
       {"repeated index", [](SyntheticDoc &s) { s.tris[1] = s.tris[0]; }, "repeated index"},
@@ -271,29 +293,18 @@ TEST(AfmFormat, WriterRefusesInvalidDocuments) {
       {"zero reference", [](SyntheticDoc &s) { s.targets[2].reference = 0; }, "reference"},
       {"duplicate part name", [](SyntheticDoc &s) { s.parts[1].name = "skin"; }, "used twice"},
   };
-  for (const Case &c : cases) {
-    SyntheticDoc s;
-    make_synthetic_doc(s);
-    c.spoil(s);
-    afm_write_options wo{};
-    afm_diag diag{};
-    wo.diag = &diag;
-    uint8_t *out = nullptr;
-    size_t n = 0;
-    afm_result r = afm_doc_write(&s.doc, &wo, &out, &n);
-    EXPECT_NE(r, AFM_OK) << c.what;
-    EXPECT_EQ(out, nullptr) << c.what;
-    EXPECT_NE(std::string(diag.message).find(c.message), std::string::npos)
-        << c.what << ": " << diag.message;
-  }
+  expect_writer_refuses(cases, sizeof cases / sizeof cases[0], afmtest::SyntheticOptions{});
 }
 
 // Damage inside Draco streams with valid CRCs: an error or a valid file,
 // never a crash (run under ASan in CI).
 TEST(AfmFormat, DamagedDracoStreamsFailCleanly) {
+ for (bool lift : {false, true}) {
+  SCOPED_TRACE(lift ? "with LIFT" : "without LIFT");
   SyntheticDoc s;
   afmtest::SyntheticOptions o;
   o.rows = 30, o.cols = 40;
+  o.lift = lift;
   std::vector<uint8_t> good = write_doc(*make_synthetic_doc(s, o), AFM_PROFILE_DRACO);
   afm_container c;
   ASSERT_EQ(afm_container_open(good.data(), good.size(), &c, nullptr), AFM_OK);
@@ -315,6 +326,157 @@ TEST(AfmFormat, DamagedDracoStreamsFailCleanly) {
   }
   EXPECT_GT(trials, 0);
   EXPECT_GT(errors, trials / 4);  // most damage is caught, and none crashes
+ }
+}
+
+// ---- control points (LIFT) -------------------------------------------------------
+
+TEST(AfmFormat, LiftRoundTripsExactlyInBothProfiles) {
+  SyntheticDoc s;
+  afmtest::SyntheticOptions o;
+  o.rows = 40, o.cols = 50;
+  o.lift = true;
+  const afm_doc *src = make_synthetic_doc(s, o);
+  const std::vector<uint8_t> raw = write_doc(*src, AFM_PROFILE_RAW), draco = write_doc(*src, AFM_PROFILE_DRACO);
+  EXPECT_EQ(chunk_encoding(raw, AFM_CHUNK_LIFT), AFM_ENCODING_RAW);
+  EXPECT_EQ(chunk_encoding(draco, AFM_CHUNK_LIFT), AFM_ENCODING_DRACO);
+  // A reader that does not know LIFT must refuse the file: the chunk is required.
+  afm_container c;
+  ASSERT_EQ(afm_container_open(raw.data(), raw.size(), &c, nullptr), AFM_OK);
+  EXPECT_EQ(c.minor, 1);
+  for (uint32_t i = 0; i < c.chunk_count; ++i) {
+    afm_chunk_info ch;
+    afm_container_chunk(&c, i, &ch);
+    if (ch.kind == AFM_CHUNK_LIFT) {
+      EXPECT_TRUE(ch.flags & AFM_CHUNK_REQUIRED);
+    }
+  }
+  for (const std::vector<uint8_t> *bytes : {&raw, &draco}) {
+    DocPtr doc;
+    afm_diag diag{};
+    ASSERT_EQ(read(*bytes, &doc, &diag), AFM_OK) << diag.message;
+    ASSERT_NE(doc->lift, nullptr);
+    EXPECT_EQ(compare_docs(*src, *doc), "");
+  }
+  uint8_t *out = nullptr;
+  size_t n = 0;
+  ASSERT_EQ(afm_transcode(draco.data(), draco.size(), AFM_PROFILE_RAW, afm_draco_codec(), nullptr, &out, &n, nullptr),
+            AFM_OK);
+  EXPECT_EQ(std::vector<uint8_t>(out, out + n), raw);
+  afm_free(nullptr, out);
+  // Every prefix of a small lifted file is refused, in both profiles.
+  o.rows = 8, o.cols = 10;
+  SyntheticDoc small;
+  const afm_doc *sd = make_synthetic_doc(small, o);
+  for (afm_profile profile : {AFM_PROFILE_RAW, AFM_PROFILE_DRACO}) {
+    const std::vector<uint8_t> bytes = write_doc(*sd, profile);
+    for (size_t k = 0; k < bytes.size(); ++k) {
+      DocPtr doc;
+      ASSERT_NE(read(std::vector<uint8_t>(bytes.begin(), bytes.begin() + k), &doc), AFM_OK)
+          << "prefix of " << k << " bytes accepted";
+    }
+  }
+}
+
+TEST(AfmFormat, LiftRulesAreEnforced) {
+  afmtest::SyntheticOptions o;
+  o.lift = true;
+  {
+    // The cases below assume the first target's first run is the eye's.
+    SyntheticDoc s;
+    make_synthetic_doc(s, o);
+    ASSERT_GE(s.target_data[0].runs.size(), 1u);
+    ASSERT_GE(s.target_data[0].runs[0].start, s.parts[1].first_vertex);
+  }
+  const SpoilCase cases[] = {
+      {"control out of range", [](SyntheticDoc &s) { s.lift_c[2][5] = s.lift.control_count; }, "control"},
+      {"weights above one", [](SyntheticDoc &s) { s.lift_w[0][9] = 20000, s.lift_w[1][9] = 20000; },
+       "pass 32768"},
+      {"no controls", [](SyntheticDoc &s) { s.lift.control_count = 0; }, "control_count is 0"},
+      {"bound run past the vertices",
+       [](SyntheticDoc &s) { s.lift_runs[0].start = s.doc.geometry.vertex_count - 10; }, "passes vertex_count"},
+      {"bound count unlike the runs", [](SyntheticDoc &s) { s.lift.bound_count -= 1; }, "bound_count"},
+      {"target over a bound vertex",
+       [](SyntheticDoc &s) {
+         // The eye's run of the first target moves down onto the last skin vertex.
+         s.target_data[0].runs[0].start = s.parts[0].vertex_count - 1;
+       },
+       "bound to control points"},
+      {"target run past the controls",
+       [](SyntheticDoc &s) { s.target_data[1].runs.back().start = s.doc.geometry.vertex_count + s.lift.control_count - 1; },
+       "passes vertex_count"},
+      {"normal deltas with a lift",
+       [](SyntheticDoc &s) {
+         SyntheticDoc::Target &t = s.target_data[0];
+         t.nx = t.ny = t.nz = t.dx;
+         s.targets[0].flags = AFM_TARGET_NORMALS;
+         s.targets[0].nx = t.nx.data(), s.targets[0].ny = t.ny.data(), s.targets[0].nz = t.nz.data();
+       },
+       "normal deltas"},
+  };
+  expect_writer_refuses(cases, sizeof cases / sizeof cases[0], o);
+  // The reader applies the same rules to a file: a control index edited in
+  // place, CRCs resealed.
+  SyntheticDoc s;
+  std::vector<uint8_t> f = write_doc(*make_synthetic_doc(s, o), AFM_PROFILE_RAW);
+  afm_container c;
+  ASSERT_EQ(afm_container_open(f.data(), f.size(), &c, nullptr), AFM_OK);
+  for (uint32_t i = 0; i < c.chunk_count; ++i) {
+    afm_chunk_info ch;
+    afm_container_chunk(&c, i, &ch);
+    if (ch.kind != AFM_CHUNK_LIFT) continue;
+    const size_t c0 = ch.offset + 12 + 8 * size_t(s.lift.run_count);  // the first c0
+    put32(&f[c0], s.lift.control_count + 7);
+    reseal_chunk(f, i);
+  }
+  DocPtr doc;
+  afm_diag diag{};
+  EXPECT_EQ(read(f, &doc, &diag), AFM_ERR_RANGE);
+  EXPECT_EQ(diag.chunk, AFM_CHUNK_LIFT) << diag.message;
+}
+
+// afm_target_expand against the LIFT formula evaluated here on the synthetic
+// document's own arrays (not through the reader): exact in Q15.
+TEST(AfmFormat, TargetExpandLiftsControlsExactly) {
+  for (bool lift : {false, true}) {
+    SyntheticDoc s;
+    afmtest::SyntheticOptions o;
+    o.lift = lift;
+    const afm_doc *src = make_synthetic_doc(s, o);
+    DocPtr doc;
+    ASSERT_EQ(read(write_doc(*src, AFM_PROFILE_DRACO), &doc), AFM_OK);
+    const size_t V = src->geometry.vertex_count, E = size_t(afm_doc_entry_count(doc.get()));
+    EXPECT_EQ(E, V + (lift ? s.lift.control_count : 0));
+    size_t bound_moved = 0;
+    for (uint32_t t = 0; t < src->target_count; ++t) {
+      // Dense deltas of every entry from the synthetic target's runs.
+      std::vector<int64_t> dense(3 * E, 0);
+      const SyntheticDoc::Target &st = s.target_data[t];
+      size_t k = 0;
+      for (const afm_run &r : st.runs)
+        for (uint32_t j = 0; j < r.length; ++j, ++k) {
+          dense[3 * (r.start + j)] = st.dx[k], dense[3 * (r.start + j) + 1] = st.dy[k];
+          dense[3 * (r.start + j) + 2] = st.dz[k];
+        }
+      std::vector<int64_t> want(3 * V);
+      for (size_t v = 0; v < 3 * V; ++v) want[v] = 32768 * dense[v];
+      if (lift)
+        for (uint32_t b = 0; b < s.lift.bound_count; ++b) {  // one run: bound vertex b is vertex b
+          const int64_t w[3] = {32768 - s.lift_w[0][b] - s.lift_w[1][b], s.lift_w[0][b], s.lift_w[1][b]};
+          for (int c = 0; c < 3; ++c) {
+            want[3 * b + size_t(c)] = 0;
+            for (int i = 0; i < 3; ++i) want[3 * b + size_t(c)] += w[i] * dense[3 * (V + s.lift_c[i][b]) + size_t(c)];
+          }
+          bound_moved += want[3 * b] || want[3 * b + 1] || want[3 * b + 2];
+        }
+      std::vector<int32_t> got(3 * E);
+      ASSERT_EQ(afm_target_expand(doc.get(), &doc->targets[t], got.data()), AFM_OK);
+      for (size_t v = 0; v < 3 * V; ++v) ASSERT_EQ(got[v], want[v]) << "target " << t << " value " << v;
+    }
+    if (lift) {
+      EXPECT_GT(bound_moved, 100u);  // the lift is exercised
+    }
+  }
 }
 
 TEST(AfmFormat, Crc32MatchesTheStandardCheckValue) {

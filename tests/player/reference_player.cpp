@@ -83,15 +83,39 @@ ReferencePose reference_pose(const afm_doc &doc, const afm_fap_state &a, const a
     double w = out.weights[i];
     // The player rounds weights to Q12: a weight that rounds to 0 moves nothing.
     if (std::fabs(w) * 4096 < 0.5) continue;
+    // The target's deltas over every entry: vertices, then the LIFT's
+    // control points (formats/afm.md), which move their bound vertices by
+    // (w0 d0 + w1 d1 + w2 d2) / 32768.
+    const size_t C = doc.lift ? doc.lift->control_count : 0;
+    std::vector<std::array<double, 3>> d(V + C, {0, 0, 0});
+    std::vector<char> has(V + C, 0);
     uint32_t k = 0;
     for (uint32_t r = 0; r < tg.run_count; ++r)
       for (uint32_t j = 0; j < tg.runs[r].length; ++j, ++k) {
-        size_t v = tg.runs[r].start + j;
-        out.positions[v][0] += w * tg.dx[k];
-        out.positions[v][1] += w * tg.dy[k];
-        out.positions[v][2] += w * tg.dz[k];
-        moved[v] = 1;
+        size_t e = tg.runs[r].start + j;
+        d[e] = {double(tg.dx[k]), double(tg.dy[k]), double(tg.dz[k])};
+        has[e] = 1;
       }
+    if (doc.lift) {
+      const afm_lift &l = *doc.lift;
+      bool any_control = false;
+      for (size_t c = 0; c < C; ++c) any_control |= has[V + c] != 0;
+      uint32_t bv = 0;  // bound vertex
+      for (uint32_t r = 0; r < l.run_count && any_control; ++r)
+        for (uint32_t j = 0; j < l.runs[r].length; ++j, ++bv) {
+          const size_t v = l.runs[r].start + j;
+          const double wt[3] = {(32768.0 - l.w1[bv] - l.w2[bv]) / 32768.0, l.w1[bv] / 32768.0, l.w2[bv] / 32768.0};
+          const uint32_t c[3] = {l.c0[bv], l.c1[bv], l.c2[bv]};
+          for (size_t x = 0; x < 3; ++x)
+            d[v][x] = wt[0] * d[V + c[0]][x] + wt[1] * d[V + c[1]][x] + wt[2] * d[V + c[2]][x];
+          has[v] = 1;
+        }
+    }
+    for (size_t v = 0; v < V; ++v) {
+      if (!has[v]) continue;
+      for (size_t x = 0; x < 3; ++x) out.positions[v][x] += w * d[v][x];
+      moved[v] = 1;
+    }
   }
 
   // Normals: the base ones, recomputed around moved vertices over seam groups.

@@ -472,3 +472,140 @@ TEST(Player, PosingAllocatesNothing) {
   free(probe);
 #endif
 }
+
+// ---- control points (LIFT) -------------------------------------------------------------------
+
+namespace {
+
+// The synthetic document with control points, read back from its raw file,
+// and a player on it.
+struct LiftedModel {
+  afmtest::SyntheticDoc source;
+  std::unique_ptr<afm_doc, DocFree> doc;
+  std::vector<uint64_t> memory;
+  afm_player *player = nullptr;
+
+  LiftedModel() {
+    afmtest::SyntheticOptions o;
+    o.rows = 40, o.cols = 50;
+    o.lift = true;
+    const std::vector<uint8_t> bytes = afmtest::write_doc(*afmtest::make_synthetic_doc(source, o), AFM_PROFILE_RAW);
+    afm_doc *d = nullptr;
+    EXPECT_EQ(afm_doc_read_alloc(bytes.data(), bytes.size(), nullptr, nullptr, &d), AFM_OK);
+    doc.reset(d);
+    player = make_player();
+  }
+  afm_player *make_player() {
+    size_t need = 0;
+    EXPECT_EQ(afm_player_measure(doc.get(), nullptr, &need), AFM_OK);
+    memory.assign(need / 8 + 1, 0xA5A5A5A5A5A5A5A5ull);  // garbage: init must not rely on zeros
+    afm_player *p = nullptr;
+    EXPECT_EQ(afm_player_init(doc.get(), nullptr, memory.data(), need, &p), AFM_OK);
+    return p;
+  }
+};
+
+// Random values of the synthetic targets' FAPs (3, 12, 31) within twice
+// their references, a viseme and an expression, and an eye turn.
+afm_fap_state lifted_state(std::mt19937 &rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  afm_fap_state s;
+  afm_fap_state_reset(&s);
+  s.value[3] = int32_t(std::lround(u(rng) * 2048));
+  s.value[12] = int32_t(std::lround(u(rng) * 1024));
+  s.value[31] = int32_t(std::lround(u(rng) * 512));
+  if (rng() % 2) s.viseme = {1, 0, uint8_t(rng() % 64), 0};
+  if (rng() % 2) s.expression = {1, uint8_t(rng() % 64), 0, 0, 0, 0};
+  s.value[23] = int32_t(std::lround(u(rng) * 30000));
+  return s;
+}
+
+}  // namespace
+
+// Error budget of a bound vertex, in quanta: the weight terms as for any
+// vertex (2^-13 * max|delta| per target, controls' deltas included), one
+// rounding of the lift to Q12 (2^-13) and the output rounding (0.5). The
+// double model lifts the controls exactly.
+TEST(Player, LiftedVerticesMatchTheDoubleModel) {
+  LiftedModel m;
+  ASSERT_NE(m.doc->lift, nullptr);
+  const afm_geometry &g = m.doc->geometry;
+  std::mt19937 rng(99);
+  double worst = 0, largest_motion = 0;
+  for (int trial = 0; trial < 30; ++trial) {
+    const afm_fap_state a = lifted_state(rng), b = lifted_state(rng);
+    const afm_q16 t = afm_q16(rng() % 65537);
+    ASSERT_EQ(afm_player_pose(m.player, &a, &b, t), AFM_OK);
+    const afmtest::ReferencePose ref = afmtest::reference_pose(*m.doc, a, b, t / 65536.0);
+    double budget = 0.5 + 1.0 / 8192;
+    for (uint32_t i = 0; i < m.doc->target_count; ++i) {
+      if (ref.weights[i] == 0) continue;
+      const afm_target &tg = m.doc->targets[i];
+      int32_t md = 0;
+      for (uint32_t k = 0; k < tg.delta_count; ++k)
+        md = std::max({md, std::abs(int32_t(tg.dx[k])), std::abs(int32_t(tg.dy[k])), std::abs(int32_t(tg.dz[k]))});
+      budget += md / 8192.0;
+    }
+    // The skin (all bound) only: the eye also turns, which the rigid test covers.
+    const uint32_t skin = g.parts[0].vertex_count;
+    for (uint32_t v = 0; v < skin; ++v) {
+      const int32_t *p = afm_player_positions(m.player) + 3 * size_t(v);
+      for (int k = 0; k < 3; ++k) {
+        const double e = std::fabs(p[k] - ref.positions[v][size_t(k)]);
+        ASSERT_LE(e, budget) << "trial " << trial << " vertex " << v << " axis " << k;
+        worst = std::max(worst, e);
+      }
+      const double moved = std::hypot(ref.positions[v][0] - g.px[v], ref.positions[v][1] - g.py[v],
+                                      ref.positions[v][2] - g.pz[v]);
+      largest_motion = std::max(largest_motion, moved);
+    }
+  }
+  std::printf("lifted vertices, fixed vs double over 30 random poses: worst error %.3f quanta, largest motion "
+              "%.0f quanta\n",
+              worst, largest_motion);
+  EXPECT_GT(largest_motion, 500);  // the controls really move the skin
+}
+
+// The player restores only what a pose changed (controls included): any
+// sequence of poses ends where one pose from a fresh player does.
+TEST(Player, LiftedPoseSequenceEqualsAFreshPose) {
+  LiftedModel seq, fresh_model;
+  std::mt19937 rng(5);
+  afm_fap_state neutral;
+  afm_fap_state_reset(&neutral);
+  for (int i = 0; i < 12; ++i) {
+    // Every third pose is neutral, or moves the eye alone (no control).
+    afm_fap_state s = lifted_state(rng);
+    if (i % 3 == 1) s = neutral;
+    if (i % 3 == 2) s = neutral, s.value[23] = 20000;
+    ASSERT_EQ(afm_player_pose(seq.player, &s, nullptr, 0), AFM_OK);
+    afm_player *fresh = fresh_model.make_player();
+    ASSERT_EQ(afm_player_pose(fresh, &s, nullptr, 0), AFM_OK);
+    const size_t n = 3 * size_t(seq.doc->geometry.vertex_count);
+    ASSERT_TRUE(std::equal(afm_player_positions(seq.player), afm_player_positions(seq.player) + n,
+                           afm_player_positions(fresh)))
+        << "pose " << i;
+    ASSERT_TRUE(std::equal(afm_player_normals(seq.player), afm_player_normals(seq.player) + n,
+                           afm_player_normals(fresh)))
+        << "pose " << i;
+  }
+}
+
+// Golden per-frame hashes of the lifted synthetic model: the lift kernel's
+// arithmetic pinned (int64 products, one rounding to Q12). Update with a
+// reason, as GoldenPerFrameHash.
+TEST(Player, LiftedGoldenPerFrameHash) {
+  LiftedModel m;
+  const afm_fap_state states[4] = {state({}), state({{3, 512}, {12, 300}}),
+                                   state({{3, 1500}, {31, -200}, {23, 40000}, {48, -15000}}),
+                                   state({{12, -900}, {31, 400}, {25, 25000}, {27, 300}})};
+  uint64_t hashes[4];
+  for (int i = 0; i < 4; ++i) {
+    ASSERT_EQ(afm_player_pose(m.player, &states[i], i ? &states[i - 1] : nullptr, 20000), AFM_OK);
+    hashes[i] = pose_hash(m.player, m.doc->geometry.vertex_count);
+    std::printf("frame %d hash %016llx\n", i, static_cast<unsigned long long>(hashes[i]));
+  }
+  const uint64_t golden[4] = {0xdfd3734a4d72cc70ull, 0x03c0cf172fab673aull, 0x4c146d0f8a0b8223ull,
+                              0xa19f9cbee7731fb6ull};
+  for (int i = 0; i < 4; ++i) EXPECT_EQ(hashes[i], golden[i]) << "frame " << i;
+}

@@ -86,7 +86,7 @@ void afm_free(const afm_allocator *allocator, void *ptr);
 
 #define AFM_MAGIC_SIZE 8          /* 0x89 'A' 'F' 'M' '\r' '\n' 0x1A '\n' */
 #define AFM_VERSION_MAJOR 1
-#define AFM_VERSION_MINOR 0
+#define AFM_VERSION_MINOR 1 /* 1.1 added LIFT */
 
 #define AFM_FOURCC(a, b, c, d)                                        \
   ((uint32_t)(uint8_t)(a) | ((uint32_t)(uint8_t)(b) << 8) |           \
@@ -95,6 +95,7 @@ void afm_free(const afm_allocator *allocator, void *ptr);
 #define AFM_CHUNK_GEOM AFM_FOURCC('G', 'E', 'O', 'M')
 #define AFM_CHUNK_MTGT AFM_FOURCC('M', 'T', 'G', 'T')
 #define AFM_CHUNK_RIGD AFM_FOURCC('R', 'I', 'G', 'D')
+#define AFM_CHUNK_LIFT AFM_FOURCC('L', 'I', 'F', 'T')
 
 #define AFM_CHUNK_REQUIRED 0x0001u /* flag: a reader that does not know it must refuse the file */
 
@@ -240,6 +241,21 @@ typedef struct afm_target {
   const int16_t *nx, *ny, *nz; /* [N] Q14 normal deltas, or NULL */
 } afm_target;
 
+/* Control points (LIFT chunk): vertices bound to three controls each, which
+ * the morph targets move instead of them. With a lift, target runs index
+ * entries [0, V + C): entry V + c is control c. A bound vertex's delta is
+ * (w0 d[V+c0] + w1 d[V+c1] + w2 d[V+c2]) / 32768 quanta with
+ * w0 = 32768 - w1 - w2 (afm_target_expand computes it). No target's runs
+ * cover a bound vertex, and no target has normal deltas. */
+typedef struct afm_lift {
+  uint32_t control_count;       /* C >= 1 */
+  uint32_t run_count;
+  const afm_run *runs;          /* [run_count] bound vertices: ascending, disjoint, < V */
+  uint32_t bound_count;         /* B = sum of run lengths */
+  const uint32_t *c0, *c1, *c2; /* [B] control indices < C, run after run */
+  const uint16_t *w1, *w2;      /* [B] Q15 weights of c1 and c2, w1 + w2 <= 32768 */
+} afm_lift;
+
 typedef enum afm_rigid_kind {
   AFM_RIGID_EYE_LEFT = 1,
   AFM_RIGID_EYE_RIGHT = 2,
@@ -284,7 +300,19 @@ typedef struct afm_doc {
   uint32_t rigid_count;
   const afm_rigid *rigids;
   uint32_t skipped_chunks; /* unknown optional chunks the reader skipped */
+  const afm_lift *lift;    /* control points, or NULL (no LIFT chunk) */
 } afm_doc;
+
+/* Entries a target's runs may index: V, plus C with a lift. */
+uint64_t afm_doc_entry_count(const afm_doc *doc);
+
+/* The position deltas target `t` (of doc) gives every entry, control
+ * points lifted: out[3 * afm_doc_entry_count(doc)], x y z per entry, in
+ * quanta times 32768 (Q15, exact: |value| < 2^30). The first 3V values are
+ * the vertices' (bound ones included), the rest the controls' own.
+ * AFM_ERR_ARGUMENT for NULLs; AFM_ERR_RANGE for a run past the entries.
+ * O(entries + deltas), no allocation. */
+afm_result afm_target_expand(const afm_doc *doc, const afm_target *t, int32_t *out);
 
 /* ---- chunk codec hooks (Draco) ------------------------------------------ */
 

@@ -18,6 +18,9 @@
  *   - FAP 2: expression_select1 at intensity1/63 plus expression_select2 at
  *     intensity2/63. init_face and the def flags are decoded and kept; they do
  *     not change blending.
+ *   - Control points (the AFM's LIFT chunk): targets move the controls, and
+ *     each bound vertex follows the Q15-weighted blend of its three controls
+ *     (formats/fap.md, "Control points").
  *   - Rigid parts (eyeballs, jaw, head) turn about their pivots as the AFM's
  *     RIGD chunk says, after the morph targets: jaw and eyes first, then the
  *     head. Rotations compose as yaw (local y) after pitch (local x) after
