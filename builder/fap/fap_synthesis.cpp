@@ -568,15 +568,53 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     o.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     res.outcome = std::move(o);
   };
+  // FAPs whose muscle group, FDP vertex, direction and value coincide are
+  // one solve: Song's inner and outer lip corners (FAPs 6/53, 7/54, 12/59,
+  // 13/60) share their vertices. The later ones copy the first's result.
+  std::vector<size_t> same_as(work.size());
+  for (size_t k = 0; k < work.size(); ++k) {
+    same_as[k] = k;
+    const FapMapping *m = work[k].fap;
+    if (!m || m->driver != FapDriver::Muscles) continue;
+    auto key = [&](size_t i) {
+      const FapMapping *f = work[i].fap;
+      const afm_fap_info *info = afm_fap(f->fap);
+      const FdpPoint *p = model.fdps.find(FdpId{info->fdp_group, info->fdp_index}, model.skin);
+      std::vector<std::pair<std::string, double>> group;
+      for (const FapContraction &c : work[i].side > 0 ? f->positive : f->negative) group.push_back({c.muscle, c.percent});
+      const Eigen::Vector3d along = work[i].side * fap_direction(info);
+      return std::make_tuple(group, p ? p->vertex : -1, along.x(), along.y(), along.z(),
+                             f->reference * fapu_distance(model.fapu, info->unit), f->lid);
+    };
+    for (size_t j = 0; j < k && same_as[k] == k; ++j)
+      if (same_as[j] == j && work[j].fap && work[j].fap->driver == FapDriver::Muscles && key(j) == key(k) &&
+          std::get<1>(key(k)) >= 0)
+        same_as[k] = j;
+  }
   std::mutex lock;
   int done = 0;
   for_each_task(work.size(), options.threads, [&](size_t k) {
-    make(k);
+    if (same_as[k] == k) make(k);
     std::lock_guard<std::mutex> g(lock);
     if (options.progress)
       options.progress(++done, static_cast<int>(work.size()),
                        work[k].high ? high_level_label(*work[k].high) : fap_label(work[k].fap->fap, work[k].side));
   });
+  for (size_t k = 0; k < work.size(); ++k) {
+    if (same_as[k] == k) continue;
+    const Result &first = results[same_as[k]];
+    Result &r = results[k];
+    r.outcome = first.outcome;
+    r.outcome.number = work[k].fap->fap;
+    r.outcome.side = work[k].side;
+    r.outcome.reference = work[k].side * work[k].fap->reference;
+    r.outcome.seconds = 0;
+    if (first.target) {
+      r.target = first.target;
+      r.target->number = work[k].fap->fap;
+      r.target->reference = r.outcome.reference;
+    }
+  }
   for (Result &r : results) {
     if (r.target) out.targets.push_back(std::move(*r.target));
     if (r.control) out.jaw.controls.push_back(*r.control);

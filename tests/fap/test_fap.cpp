@@ -619,6 +619,38 @@ DocPtr encoded_doc(const AfmContent &content) {
   return DocPtr(doc, [](afm_doc *d) { afm_free(nullptr, d); });
 }
 
+// FAPs that are the same solve (group, FDP vertex, direction and value; on
+// Song the inner and outer lip corners share vertices) are solved once and
+// the others copy the result: here FAP 59's FDP 8.3 is put on FAP 12's 2.4.
+// The copy equals FAP 59 solved on its own, bit for bit.
+TEST(FapSynthesis, AFapThatIsTheSameSolveAsAnotherCopiesItsTarget) {
+  const Built &b = head_1k();
+  FaceModel m = b.model;
+  const FdpPoint *inner = m.fdps.find(FdpId{2, 4}, m.skin);
+  ASSERT_TRUE(inner && inner->part == m.skin);
+  const FdpPoint in = *inner;
+  for (FdpPoint &p : m.fdps.points)
+    if (p.id == FdpId{8, 3}) p.part = in.part, p.vertex = in.vertex, p.pos = in.pos;
+  FapSynthesisOptions o;
+  o.only = {12, 59};
+  o.negative_sides = false;
+  Expected<FapSynthesis> both = synthesize_faps(b.head.scene, m, o);
+  ASSERT_TRUE(both.is_ok()) << both.status().message();
+  o.only = {59};
+  Expected<FapSynthesis> alone = synthesize_faps(b.head.scene, m, o);
+  ASSERT_TRUE(alone.is_ok()) << alone.status().message();
+  ASSERT_EQ(both->targets.size(), 2u);
+  ASSERT_EQ(alone->targets.size(), 1u);
+  const size_t skin = static_cast<size_t>(m.skin);
+  EXPECT_EQ(both->targets[1].number, 59);
+  EXPECT_EQ(both->targets[1].displacement[skin], alone->targets[0].displacement[skin]);
+  EXPECT_EQ(both->targets[1].displacement[skin], both->targets[0].displacement[skin]);
+  EXPECT_EQ(both->outcomes[1].seconds, 0) << "solved again instead of copied";
+  EXPECT_GT(both->outcomes[0].seconds, 0);
+  EXPECT_EQ(both->outcomes[1].reference, 150);
+  EXPECT_EQ(both->outcomes[1].achieved, alone->outcomes[0].achieved);
+}
+
 // The simulation mesh (anatomy/sim_mesh.h) against the skin itself: the
 // 1k head's targets for FAPs 12 and 33 made on an 800-vertex copy of its
 // skin and carried back agree with those made on the whole skin. The FDP
