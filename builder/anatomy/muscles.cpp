@@ -95,15 +95,31 @@ Expected<Muscle> place_muscle(const SkinModel &skin, const FdpSet &fdps, int def
     m.semi_b = std::abs(skin.X0(m.node_b, 1) - m.epicentre.y());
     if (!(m.semi_a > 0) || !(m.semi_b > 0))
       return Status::error(std::string("muscle ") + d.name + ": a semi-axis has zero length");
-    const int near = nearest_node(skin, kEpidermis, m.epicentre);
-    m.epicentre_normal = skin.normal.row(skin.vertex_of(near));
+    // The influence area is found on the skin's surface, where the FDPs are:
+    // the ellipse through the key points themselves, the skin vertices
+    // tested. (With the hypodermis nodes, traced toward the centre of
+    // gravity, against the FDPs' epicentre, Song's mouth ellipse was 0.86
+    // units high and its area missed the upper lip: the lower lip's inner
+    // nodes rise toward the mouth's centre, the upper lip's away from it.)
+    m.area_a = std::abs(m.key_a.x() - m.epicentre.x());
+    m.area_b = std::abs(m.key_b.y() - m.epicentre.y());
+    if (!(m.area_a > 0) || !(m.area_b > 0))
+      return Status::error(std::string("muscle ") + d.name + ": a semi-axis has zero length");
+    // Equation 2's normal at the epicentre: the epicentre lies in an
+    // orifice, where there is no skin; the vertex nearest it is on the rim,
+    // turned into the orifice (Song's eyes' pointed down, its mouth's up),
+    // and the skin within the ellipse folds into the socket and the mouth
+    // (the mean of its normals on Song's whole skin pointed backward). The
+    // paper's intent is the front of the face: +z, the gaze of the MPEG-4
+    // neutral frame, as it notes for equation 1.
+    m.epicentre_normal = Eigen::Vector3d::UnitZ();
     for (int v = 0; v < skin.n; ++v) {
       if (!skin.in_mesh[static_cast<size_t>(v)]) continue;
-      const Eigen::Vector3d p = skin.X0.row(skin.node(kHypodermis, v));
-      const double ex = (p.x() - m.epicentre.x()) / m.semi_a, ey = (p.y() - m.epicentre.y()) / m.semi_b;
+      const Eigen::Vector3d p = skin.X0.row(skin.node(kEpidermis, v));
+      const double ex = (p.x() - m.epicentre.x()) / m.area_a, ey = (p.y() - m.epicentre.y()) / m.area_b;
       const double rho = std::sqrt(ex * ex + ey * ey);
-      if (rho > m.width) continue;                                           // equation 1
-      if (skin.normal.row(v).dot(m.epicentre_normal) < 0) continue;           // equation 2
+      if (rho > m.width) continue;                                    // equation 1
+      if (skin.normal.row(v).dot(m.epicentre_normal) < 0) continue;  // equation 2
       const double g = rho <= 1 ? 1.0 : std::cos(kHalfPi * (rho - 1) / (m.width - 1));
       const double w = skin.area[v] * g;
       if (w <= 0) continue;

@@ -54,7 +54,10 @@ struct Muscle {
   // Sphincter.
   Eigen::Vector3d epicentre = Eigen::Vector3d::Zero();
   Eigen::Vector3d epicentre_normal = Eigen::Vector3d::UnitZ();
-  double semi_a = 0, semi_b = 0;  // model units, along x and y
+  double semi_a = 0, semi_b = 0;  // model units, along x and y, at the hypodermis key nodes
+                                  // (the calibration's scale and the pull's core)
+  double area_a = 0, area_b = 0;  // the ellipse through the key points on the skin's
+                                  // surface: equation 1's axes, and what pictures draw
   double width = 0;        // omega, or the sphincter's ellipse scale k
   int force_layer = kDermis;  // kDermis (linear) or kHypodermis (sphincter)
   std::vector<int> influence;   // skin vertices, sorted

@@ -225,7 +225,7 @@ Status check_muscle(const FaceModel &model, const Muscle &m, const std::string &
     return Status::error(path + ": muscle " + m.name + " has a node out of range (" +
                          std::to_string(m.node_a) + ", " + std::to_string(m.node_b) + " of " +
                          std::to_string(model.tissue.X0.rows()) + ")");
-  if (m.kind == MuscleKind::Sphincter && !(m.semi_a > 0 && m.semi_b > 0))
+  if (m.kind == MuscleKind::Sphincter && !(m.area_a > 0 && m.area_b > 0))
     return Status::error(path + ": sphincter " + m.name + " has no semi-axes");
   return Status::ok();
 }
@@ -249,7 +249,7 @@ void muscle_overlay(const FaceModel &model, const Epidermis &skin, const Scale &
     }
   } else {
     const Eigen::MatrixXd ellipse =
-        rows_of(skin.project_ellipse(m.epicentre, m.semi_a, m.semi_b, scale.spacing));
+        rows_of(skin.project_ellipse(m.epicentre, m.area_a, m.area_b, scale.spacing));
     add_outlined(lines, ellipse, kWhite, kLinePixels, scale.bias, scale.step);
     if (key_dots)
       add_outlined(dots, rows_of({a0, b0}), kRed, kDotPixels, dot_bias, scale.step);

@@ -786,9 +786,9 @@ TEST(HighLevel, SongsEyeSphinctersCalibrateAlikeAndKeepTheSkinWhole) {
 }
 
 // Joy on the generated 2k head, simulated on 1,000 vertices, folds the
-// cheeks over (0.08 % of the skin's area turned) where the zygomatici and
-// the eye sphincters act. Only the muscles to blame are reduced: risorius
-// and the jaw keep the table's contraction, and the target is that pose.
+// cheeks over (0.08 % of the skin's area turned) where the zygomatici act.
+// Only the muscles to blame are reduced: risorius, the eye sphincters and
+// the jaw keep the table's contraction, and the target is that pose.
 TEST(HighLevel, AnExpressionThatTearsTheSkinReducesTheMusclesThatTearIt) {
   RefHeadOptions ho;
   ho.skin_vertices = 2000;
@@ -808,8 +808,7 @@ TEST(HighLevel, AnExpressionThatTearsTheSkinReducesTheMusclesThatTearIt) {
   ASSERT_EQ(syn->outcomes.size(), 1u);
   const FapOutcome &out = syn->outcomes[0];
   ASSERT_TRUE(out.made) << out.message;
-  EXPECT_NE(out.message.find(": zygomaticus_major, zygomaticus_minor, orbicularis_oculi at "), std::string::npos)
-      << out.message;
+  EXPECT_NE(out.message.find(": zygomaticus_major, zygomaticus_minor at "), std::string::npos) << out.message;
   EXPECT_GT(out.scale, 0.0);
   EXPECT_LT(out.scale, 1.0);
   ASSERT_EQ(syn->targets.size(), 1u);
@@ -829,11 +828,12 @@ TEST(HighLevel, AnExpressionThatTearsTheSkinReducesTheMusclesThatTearIt) {
     ((jaw_motion(m.jaw, mid, 0, 0) * c - c).dot(dir) < drop ? lo : hi) = mid;
   }
   // The table's pose tears; the pose with the blamed muscles at the
-  // share and the rest (risorius, the jaw) at the table's is the target.
+  // share and the rest (risorius, the eye sphincters, the jaw) at the
+  // table's is the target.
   auto pose = [&](bool reduce) {
     Activation a;
     for (const FapContraction &k : h->muscles) {
-      const bool blamed = k.muscle.rfind("risorius", 0) != 0;
+      const bool blamed = k.muscle.rfind("zygomaticus", 0) == 0;
       a.muscles.push_back({m.find(k.muscle), k.percent * (reduce && blamed ? out.scale : 1.0)});
     }
     a.jaw_open = 0.5 * (lo + hi);
@@ -846,7 +846,14 @@ TEST(HighLevel, AnExpressionThatTearsTheSkinReducesTheMusclesThatTearIt) {
   ASSERT_EQ(table.rows(), D.rows());
   ASSERT_EQ(reduced.rows(), D.rows());
   EXPECT_TRUE(skin_faults(m, X0 + table).tears());
-  EXPECT_LT((D - reduced).rowwise().norm().maxCoeff(), 2 * m.quantum);
+  // The target's pose was solved from the bisection's last share, this one
+  // from rest: both within the solver's tolerance, 3 quanta apart at most
+  // where the cheeks fold (measured), while the table's pose lies far away.
+  EXPECT_LT((D - reduced).rowwise().norm().maxCoeff(), 4 * m.quantum);
+  std::printf("joy on the 2k head: the target and the reduced pose %.1f quanta apart, the table's pose %.1f\n",
+              (D - reduced).rowwise().norm().maxCoeff() / m.quantum,
+              (table - reduced).rowwise().norm().maxCoeff() / m.quantum);
+  EXPECT_GT((table - reduced).rowwise().norm().maxCoeff(), 10 * m.quantum);
 }
 
 TEST(FapSynthesis, TheAfmHoldsTheTargetsAndTheJaw) {
