@@ -5,7 +5,7 @@
  * the `draco` member of afm_read_options / afm_write_options or to
  * afm_transcode. formats/afm.md ("draco encoding") gives the bitstream
  * layout: GEOM parts become Draco meshes with integer attributes, MTGT deltas
- * a Draco point cloud; every quantised value survives exactly.
+ * and LIFT bindings Draco point clouds; every quantised value survives exactly.
  *
  * The encoder keeps the raw encoding for a chunk unless Draco makes it at
  * least AFM_DRACO_MIN_SAVING_PERCENT smaller: below that, decoding time is

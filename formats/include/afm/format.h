@@ -360,7 +360,7 @@ afm_result afm_doc_read_alloc(const uint8_t *data, size_t size, const afm_read_o
 
 typedef enum afm_profile {
   AFM_PROFILE_RAW = 0,  /* every chunk raw: for embedded readers */
-  AFM_PROFILE_DRACO = 1 /* GEOM and MTGT through the codec where it is smaller */
+  AFM_PROFILE_DRACO = 1 /* GEOM, LIFT and MTGT through the codec where it is smaller */
 } afm_profile;
 
 typedef struct afm_write_options {
@@ -375,7 +375,7 @@ typedef struct afm_write_options {
 afm_result afm_doc_write(const afm_doc *doc, const afm_write_options *options, uint8_t **out,
                          size_t *out_size);
 
-/* Re-encodes every GEOM and MTGT chunk of a file for `profile`, copying the
+/* Re-encodes every GEOM, LIFT and MTGT chunk of a file for `profile`, copying the
  * other chunks (known or not) unchanged. Quantised values are kept exactly. */
 afm_result afm_transcode(const uint8_t *data, size_t size, afm_profile profile,
                          const afm_chunk_codec *draco, const afm_allocator *allocator,
@@ -384,7 +384,7 @@ afm_result afm_transcode(const uint8_t *data, size_t size, afm_profile profile,
 /* ---- single chunks (used by codecs) ------------------------------------- */
 
 /* Raw GEOM / MTGT payloads to and from their structs. `vertex_count` checks
- * MTGT run ranges. A NULL buffer with buffer_size 0 measures: *bytes gets the
+ * MTGT run ranges (pass V + C for a file with control points). A NULL buffer with buffer_size 0 measures: *bytes gets the
  * size the struct needs. */
 afm_result afm_geometry_decode(const uint8_t *raw, size_t size, void *buffer, size_t buffer_size,
                                size_t *bytes, afm_geometry *geometry, afm_diag *diag);
