@@ -66,6 +66,35 @@ Grid position_grid(const Scene &scene) {
   return g;
 }
 
+// The order of n points that keeps each field's moved points in few runs:
+// sorted by which fields move them (fields taken largest first), ties in
+// index order. `fields` are #n x 3 displacements (others are ignored).
+std::vector<int> membership_order(size_t n, const std::vector<const Eigen::MatrixXd *> &fields, double quantum) {
+  std::vector<std::vector<char>> columns;
+  std::vector<size_t> sizes;
+  for (const Eigen::MatrixXd *D : fields) {
+    if (!D || D->rows() != static_cast<Eigen::Index>(n)) continue;
+    std::vector<char> moved(n, 0);
+    size_t count = 0;
+    for (size_t v = 0; v < n; ++v)
+      if (D->row(static_cast<Eigen::Index>(v)).cwiseAbs().maxCoeff() >= quantum / 2) moved[v] = 1, ++count;
+    if (count) columns.push_back(std::move(moved)), sizes.push_back(count);
+  }
+  std::vector<size_t> by_size(columns.size());
+  std::iota(by_size.begin(), by_size.end(), size_t{0});
+  std::stable_sort(by_size.begin(), by_size.end(), [&](size_t a, size_t b) { return sizes[a] > sizes[b]; });
+  std::vector<int> order(n);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    for (size_t c : by_size) {
+      char x = columns[c][static_cast<size_t>(a)], y = columns[c][static_cast<size_t>(b)];
+      if (x != y) return x > y;  // moved points first, grouped by signature
+    }
+    return false;
+  });
+  return order;
+}
+
 // The lift's shape against the scene and the targets.
 Status check_lift(const AfmContent &content) {
   const Scene &scene = *content.scene;
@@ -104,39 +133,6 @@ Status check_lift(const AfmContent &content) {
 }  // namespace
 
 double afm_position_quantum(const Scene &scene) { return static_cast<double>(position_grid(scene).step); }
-
-namespace {
-
-// The order of n points that keeps each field's moved points in few runs:
-// sorted by which fields move them (fields taken largest first), ties in
-// index order. `fields` are #n x 3 displacements (others are ignored).
-std::vector<int> membership_order(size_t n, const std::vector<const Eigen::MatrixXd *> &fields, double quantum) {
-  std::vector<std::vector<char>> columns;
-  std::vector<size_t> sizes;
-  for (const Eigen::MatrixXd *D : fields) {
-    if (!D || D->rows() != static_cast<Eigen::Index>(n)) continue;
-    std::vector<char> moved(n, 0);
-    size_t count = 0;
-    for (size_t v = 0; v < n; ++v)
-      if (D->row(static_cast<Eigen::Index>(v)).cwiseAbs().maxCoeff() >= quantum / 2) moved[v] = 1, ++count;
-    if (count) columns.push_back(std::move(moved)), sizes.push_back(count);
-  }
-  std::vector<size_t> by_size(columns.size());
-  std::iota(by_size.begin(), by_size.end(), size_t{0});
-  std::stable_sort(by_size.begin(), by_size.end(), [&](size_t a, size_t b) { return sizes[a] > sizes[b]; });
-  std::vector<int> order(n);
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
-    for (size_t c : by_size) {
-      char x = columns[c][static_cast<size_t>(a)], y = columns[c][static_cast<size_t>(b)];
-      if (x != y) return x > y;  // moved points first, grouped by signature
-    }
-    return false;
-  });
-  return order;
-}
-
-}  // namespace
 
 std::vector<std::vector<int>> run_friendly_order(const Scene &scene,
                                                  const std::vector<MorphTarget> &targets,

@@ -737,6 +737,18 @@ TEST(FapSynthesis, TargetsMadeOnACoarserSimulationMeshMatchTheSkins) {
     std::printf("FAP %d: lifted AFM deltas against the builder's: worst %.3f quanta (bound %.3f)\n", int(at.number),
                 worst, bound);
   }
+  // A lift the AFM cannot hold is refused with a message, not written.
+  AfmContent bad = content;
+  bad.lift.parts[0].corner(0, 1) = bad.lift.control_count;
+  Expected<std::vector<uint8_t>> refused = encode_afm(bad, AFM_PROFILE_RAW);
+  ASSERT_FALSE(refused.is_ok());
+  EXPECT_NE(refused.status().message().find("names a control out of range"), std::string::npos)
+      << refused.status().message();
+  bad = content;
+  bad.targets[0].normals = true;
+  refused = encode_afm(bad, AFM_PROFILE_RAW);
+  ASSERT_FALSE(refused.is_ok());
+  EXPECT_NE(refused.status().message().find("no normal deltas"), std::string::npos) << refused.status().message();
 }
 
 // Song on afm-build's simulation mesh, its eye sphincters calibrated.
