@@ -254,12 +254,6 @@ std::vector<std::vector<float>> dense_floats(const afm_doc &doc, const std::vect
   return out;
 }
 
-bool with_normals_any(const afm_doc &doc) {
-  for (uint32_t t = 0; t < doc.target_count; ++t)
-    if (doc.targets[t].nx) return true;
-  return false;
-}
-
 // The same from whole quanta (the baseline's values).
 std::vector<std::vector<float>> quanta_floats(const afm_doc &doc, const std::vector<std::vector<int16_t>> &dense) {
   const size_t V = doc.geometry.vertex_count;
@@ -362,13 +356,13 @@ void measure(const Input &in) {
   const std::vector<std::vector<int32_t>> q15 = dense_q15(*doc);
   // The baseline's quanta: the builder's own targets rounded per vertex when
   // built here (the same half-quantum error as the AFM's), else the AFM's.
+  size_t with_normals = 0;
+  for (size_t t = 0; t < T; ++t) with_normals += components(doc->targets[t]) == 6;
   std::vector<std::vector<int16_t>> dense = dense_quanta(*doc, q15);
-  if (in.exact.size() == T && !with_normals_any(*doc))
+  if (in.exact.size() == T && !with_normals)
     for (size_t t = 0; t < T; ++t)
       for (size_t i = 0; i < 3 * V; ++i)
         dense[t][i] = static_cast<int16_t>(std::lround(in.exact[t][i] / double(doc->geometry.step)));
-  size_t with_normals = 0;
-  for (size_t t = 0; t < T; ++t) with_normals += components(doc->targets[t]) == 6;
   const size_t dense_bytes = (T + with_normals) * V * 3 * 4;
   const size_t base_bytes = baseline_bytes(dense, V);
   const std::vector<std::vector<float>> dense_f = dense_floats(*doc, q15);

@@ -111,15 +111,14 @@ Expected<Muscle> place_muscle(const SkinModel &skin, const FdpSet &fdps, int def
     // and the skin within the ellipse folds into the socket and the mouth
     // (the mean of its normals on Song's whole skin pointed backward). The
     // paper's intent is the front of the face: +z, the gaze of the MPEG-4
-    // neutral frame, as it notes for equation 1.
-    m.epicentre_normal = Eigen::Vector3d::UnitZ();
+    // neutral frame, as it notes for equation 1: a normal's z.
     for (int v = 0; v < skin.n; ++v) {
       if (!skin.in_mesh[static_cast<size_t>(v)]) continue;
       const Eigen::Vector3d p = skin.X0.row(skin.node(kEpidermis, v));
       const double ex = (p.x() - m.epicentre.x()) / m.area_a, ey = (p.y() - m.epicentre.y()) / m.area_b;
       const double rho = std::sqrt(ex * ex + ey * ey);
       if (rho > m.width) continue;                                    // equation 1
-      if (skin.normal.row(v).dot(m.epicentre_normal) < 0) continue;  // equation 2
+      if (skin.normal(v, 2) < 0) continue;                            // equation 2
       const double g = rho <= 1 ? 1.0 : std::cos(kHalfPi * (rho - 1) / (m.width - 1));
       const double w = skin.area[v] * g;
       if (w <= 0) continue;

@@ -53,7 +53,6 @@ struct Muscle {
   double length = 0;       // linear: rest fibre length |node_b - node_a|
   // Sphincter.
   Eigen::Vector3d epicentre = Eigen::Vector3d::Zero();
-  Eigen::Vector3d epicentre_normal = Eigen::Vector3d::UnitZ();
   double semi_a = 0, semi_b = 0;  // model units, along x and y, at the hypodermis key nodes
                                   // (the calibration's scale and the pull's core)
   double area_a = 0, area_b = 0;  // the ellipse through the key points on the skin's

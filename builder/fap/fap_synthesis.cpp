@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <mutex>
 #include <optional>
+#include <tuple>
 
 #include "afm/rigid_parts.h"
 #include "anatomy/skin_binding.h"
@@ -571,25 +572,25 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
   // FAPs whose muscle group, FDP vertex, direction and value coincide are
   // one solve: Song's inner and outer lip corners (FAPs 6/53, 7/54, 12/59,
   // 13/60) share their vertices. The later ones copy the first's result.
+  using SolveKey = std::tuple<std::vector<std::pair<std::string, double>>, int, double, double, double, double, int>;
+  std::vector<std::optional<SolveKey>> keys(work.size());
+  for (size_t k = 0; k < work.size(); ++k) {
+    const FapMapping *f = work[k].fap;
+    if (!f || f->driver != FapDriver::Muscles) continue;
+    const afm_fap_info *info = afm_fap(f->fap);
+    const FdpPoint *p = model.fdps.find(FdpId{info->fdp_group, info->fdp_index}, model.skin);
+    if (!p || p->part != model.skin || p->vertex < 0) continue;  // not made: no copy
+    std::vector<std::pair<std::string, double>> group;
+    for (const FapContraction &c : work[k].side > 0 ? f->positive : f->negative) group.push_back({c.muscle, c.percent});
+    const Eigen::Vector3d along = work[k].side * fap_direction(info);
+    keys[k] = SolveKey{group, p->vertex, along.x(), along.y(), along.z(),
+                       f->reference * fapu_distance(model.fapu, info->unit), f->lid};
+  }
   std::vector<size_t> same_as(work.size());
   for (size_t k = 0; k < work.size(); ++k) {
     same_as[k] = k;
-    const FapMapping *m = work[k].fap;
-    if (!m || m->driver != FapDriver::Muscles) continue;
-    auto key = [&](size_t i) {
-      const FapMapping *f = work[i].fap;
-      const afm_fap_info *info = afm_fap(f->fap);
-      const FdpPoint *p = model.fdps.find(FdpId{info->fdp_group, info->fdp_index}, model.skin);
-      std::vector<std::pair<std::string, double>> group;
-      for (const FapContraction &c : work[i].side > 0 ? f->positive : f->negative) group.push_back({c.muscle, c.percent});
-      const Eigen::Vector3d along = work[i].side * fap_direction(info);
-      return std::make_tuple(group, p ? p->vertex : -1, along.x(), along.y(), along.z(),
-                             f->reference * fapu_distance(model.fapu, info->unit), f->lid);
-    };
-    for (size_t j = 0; j < k && same_as[k] == k; ++j)
-      if (same_as[j] == j && work[j].fap && work[j].fap->driver == FapDriver::Muscles && key(j) == key(k) &&
-          std::get<1>(key(k)) >= 0)
-        same_as[k] = j;
+    for (size_t j = 0; keys[k] && j < k && same_as[k] == k; ++j)
+      if (same_as[j] == j && keys[j] == keys[k]) same_as[k] = j;
   }
   std::mutex lock;
   int done = 0;
