@@ -16,6 +16,7 @@
 #include "core/parallel.h"
 #include "core/part_kind.h"
 #include "fap/fap_mapping.h"
+#include "fap/fap_partition.h"
 
 namespace afmb {
 
@@ -141,6 +142,16 @@ void keep_lid_half(const FaceModel &model, int fap, int lid, Eigen::MatrixXd &D)
     const double s = std::clamp(lid * (model.tissue.X0(v, 1) - mid) / open + 0.5, 0.0, 1.0);
     D.row(v) *= s * s * (3 - 2 * s);
   }
+}
+
+// The errors of achieved FDP motion against o.prescribed, along the FAP's
+// direction `dir` and off it.
+void measure(FapOutcome &o, const Eigen::Vector3d &achieved, const Eigen::Vector3d &dir) {
+  o.achieved = achieved;
+  const double len = o.prescribed.norm();
+  const double a = o.achieved.dot(dir);
+  o.along_error = std::abs(a - o.prescribed.dot(dir)) / len;
+  o.off_axis = (o.achieved - a * dir).norm() / len;
 }
 
 std::string high_level_label(const HighLevelMapping &h) {
@@ -550,11 +561,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     if (ok) {
       Eigen::MatrixXd D = shrink * (pose_epidermis(model, pose) - skin.X0.topRows(skin.n));
       if (map->lid) keep_lid_half(model, map->fap, map->lid, D);
-      o.achieved = D.row(fdp->vertex).transpose();
-      const double len = o.prescribed.norm();
-      const double a = o.achieved.dot(dir);
-      o.along_error = std::abs(a - o.prescribed.dot(dir)) / len;
-      o.off_axis = (o.achieved - a * dir).norm() / len;
+      measure(o, D.row(fdp->vertex).transpose(), dir);
       o.dynamic = static_cast<int>(pose.dynamic.size());
       o.made = true;
       MorphTarget t;
@@ -614,6 +621,58 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       r.target = first.target;
       r.target->number = work[k].fap->fap;
       r.target->reference = r.outcome.reference;
+    }
+  }
+  // FAP targets whose groups share a muscle split the skin (fap_partition.h).
+  {
+    std::vector<SharingTarget> sharing(work.size());
+    std::vector<Eigen::Vector3d> dirs(work.size(), Eigen::Vector3d::Zero());
+    for (size_t k = 0; k < work.size(); ++k) {
+      const FapMapping *f = work[k].fap;
+      if (!f || f->driver != FapDriver::Muscles || f->lid || !results[k].target) continue;
+      const afm_fap_info *info = afm_fap(f->fap);
+      const FdpPoint *p = model.fdps.find(FdpId{info->fdp_group, info->fdp_index}, model.skin);
+      if (!p || p->part != model.skin || p->vertex < 0) continue;
+      sharing[k].fap = f->fap;
+      sharing[k].vertex = p->vertex;
+      for (const FapContraction &c : work[k].side > 0 ? f->positive : f->negative)
+        sharing[k].muscles.push_back({c.muscle, c.percent > 0 ? +1 : -1});
+      dirs[k] = fap_direction(info);
+      sharing[k].direction = dirs[k];
+    }
+    const FapPartition part = partition_shared_targets(skin.X0.topRows(skin.n), sharing);
+    const size_t sk = static_cast<size_t>(model.skin);
+    for (size_t k = 0; k < work.size(); ++k) {
+      if (part.weight[k].size() == 0) continue;
+      MorphTarget &t = *results[k].target;
+      Eigen::MatrixXd D = t.displacement[sk];
+      D.array().colwise() *= part.weight[k].array();
+      for (const SkinBinding &b : carried) t.displacement[static_cast<size_t>(b.part)] = Eigen::MatrixXd();
+      t.displacement[sk] = D;
+      carry(D, t);
+    }
+    // A target whose FDP is another FAP's too, in the same direction (the
+    // lip corners), moves it by a share: it is measured with those FAPs at
+    // the same value.
+    for (size_t k = 0; k < work.size(); ++k) {
+      if (part.weight[k].size() == 0) continue;
+      FapOutcome &o = results[k].outcome;
+      const int v = sharing[k].vertex;
+      Eigen::Vector3d achieved = results[k].target->displacement[sk].row(v).transpose();
+      std::string with;
+      for (size_t j = 0; j < work.size(); ++j) {
+        if (j == k || part.component[j] != part.component[k] || sharing[j].vertex != v ||
+            work[j].side != work[k].side || sharing[j].fap == sharing[k].fap || dirs[j] != dirs[k] ||
+            part.weight[j].size() == 0)
+          continue;
+        achieved += static_cast<double>(work[k].fap->reference) / work[j].fap->reference *
+                    results[j].target->displacement[sk].row(v).transpose();
+        with += (with.empty() ? "" : ", ") + std::to_string(sharing[j].fap);
+      }
+      measure(o, achieved, dirs[k]);
+      if (!with.empty())
+        o.message += std::string(o.message.empty() ? "" : "; ") + "its FDP is FAP " + with +
+                     "'s too: each moves it by a share, measured together at the same value";
     }
   }
   for (Result &r : results) {

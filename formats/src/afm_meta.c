@@ -82,3 +82,14 @@ afm_result afm_meta_encode(const afm_meta *meta, afm_writer *w) {
   }
   return w->overflow ? AFM_ERR_BUFFER_TOO_SMALL : AFM_OK;
 }
+
+double afm_meta_fapu_x0(const afm_meta *meta, afm_fapu unit) {
+  switch (unit) {
+    case AFM_FAPU_IRISD: return meta->irisd0;
+    case AFM_FAPU_ES: return meta->es0;
+    case AFM_FAPU_ENS: return meta->ens0;
+    case AFM_FAPU_MNS: return meta->mns0;
+    case AFM_FAPU_MW: return meta->mw0;
+    default: return 0;
+  }
+}

@@ -1,6 +1,7 @@
 /* afm-play: play a FAP stream on an AFM, print a line (or hash) per frame. */
 #define _POSIX_C_SOURCE 199309L
 #include <errno.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -10,6 +11,7 @@
 #include "afm/draco.h"
 #include "afm/fap_stream.h"
 #include "afm/format.h"
+#include "afm/mpeg4.h"
 #include "afm/player.h"
 
 static void usage(FILE *out) {
@@ -30,11 +32,21 @@ static void usage(FILE *out) {
           "                   io (inner/outer lip) or lr,io; off by default\n"
           "  --normal-deltas  blend the AFM's stored normal deltas instead of\n"
           "                   recomputing normals\n"
+          "  --fdp-motion     after playing, each FDP group's motion against the stream's\n"
+          "                   MPEG-4 prescription (see below)\n"
           "  --quiet          no per-frame lines, only the summary\n"
           "  --help           this text\n"
           "\n"
           "The hash is FNV-1a 64 over each vertex's x y z (int32 quanta) and normal\n"
           "(Q14), little-endian: the same on every platform for the same input.\n"
+          "\n"
+          "--fdp-motion: in every frame, each FDP that a distance FAP names should move\n"
+          "by the sum over those FAPs of value x FAPU along the FAP's direction (the\n"
+          "MPEG-4 rule). Where that prescription is at least MNS0 / 20 long, the FDP's\n"
+          "played motion (the head's rotation left out) is compared with it: per FDP\n"
+          "group, the median share of the prescription reached along it, the median\n"
+          "distance from it relative to its length, and the 90th percentile share\n"
+          "(1 is exact; above 1, the face overshoots the stream).\n"
           "Exit status: 0 on success, 1 on bad input (the message names the file and\n"
           "line or field), 2 on bad usage.\n");
 }
@@ -142,6 +154,94 @@ static int write_obj(const char *dir, uint32_t index, const afm_doc *doc, const 
   return 1;
 }
 
+/* --fdp-motion (see usage): samples per FDP group 1..11. */
+typedef struct fdp_motion {
+  uint32_t point[AFM_FAP_COUNT + 1]; /* per FAP 3..68: its FDP's index in meta.fdps, or AFM_NONE */
+  double *share[12], *error[12];     /* per group: along share and relative distance */
+  uint32_t count[12], capacity;
+} fdp_motion;
+
+/* Which FDP each distance FAP names (the first point of that id on a
+ * vertex), and room for `frames` samples of every FDP in each group. */
+static int fdp_motion_init(fdp_motion *fm, const afm_doc *doc, uint32_t frames) {
+  uint32_t f, i, g;
+  memset(fm, 0, sizeof *fm);
+  for (f = 0; f <= AFM_FAP_COUNT; ++f) fm->point[f] = AFM_NONE;
+  for (f = 3; f <= AFM_FAP_COUNT; ++f) {
+    const afm_fap_info *info = afm_fap((int)f);
+    if (!info || info->motion != AFM_MOTION_TRANSLATE || afm_meta_fapu_x0(&doc->meta, info->unit) <= 0) continue;
+    for (i = 0; i < doc->meta.fdp_count && fm->point[f] == AFM_NONE; ++i) {
+      const afm_fdp_point *p = &doc->meta.fdps[i];
+      if (p->group == info->fdp_group && p->index == info->fdp_index && p->vertex != AFM_NONE) fm->point[f] = i;
+    }
+  }
+  fm->capacity = frames * (doc->meta.fdp_count ? doc->meta.fdp_count : 1);
+  for (g = 0; g < 12; ++g) {
+    fm->share[g] = (double *)malloc(fm->capacity * sizeof(double));
+    fm->error[g] = (double *)malloc(fm->capacity * sizeof(double));
+    if (!fm->share[g] || !fm->error[g]) return 0;
+  }
+  return 1;
+}
+
+static void fdp_motion_free(fdp_motion *fm) {
+  int g;
+  for (g = 0; g < 12; ++g) free(fm->share[g]), free(fm->error[g]);
+}
+
+/* One pose: the values of states a and b blended by t (Q16), the player's
+ * vertices without the head's motion. */
+static void fdp_motion_add(fdp_motion *fm, const afm_doc *doc, const afm_player *p, const afm_fap_state *a,
+                           const afm_fap_state *b, afm_q16 t) {
+  const afm_geometry *geo = &doc->geometry;
+  const int32_t *x = afm_player_positions(p);
+  const double limit = doc->meta.mns0 / 20.0;
+  uint32_t i, f;
+  for (i = 0; i < doc->meta.fdp_count; ++i) {
+    const afm_fdp_point *pt = &doc->meta.fdps[i];
+    double want[3] = {0, 0, 0}, got[3], len = 0, along = 0, off = 0;
+    int named = 0, k;
+    for (f = 3; f <= AFM_FAP_COUNT; ++f) {
+      const afm_fap_info *info;
+      double v, unit;
+      if (fm->point[f] != i) continue;
+      info = afm_fap((int)f);
+      v = a->value[f] + (double)(b->value[f] - a->value[f]) * t / 65536.0;
+      unit = afm_meta_fapu_x0(&doc->meta, info->unit) / 1024.0;
+      for (k = 0; k < 3; ++k) want[k] += v * unit * info->direction[k];
+      named = 1;
+    }
+    if (!named || pt->group > 11 || fm->count[pt->group] >= fm->capacity) continue;
+    for (k = 0; k < 3; ++k) len += want[k] * want[k];
+    len = sqrt(len);
+    if (!(len >= limit) || limit <= 0) continue;
+    got[0] = (double)(x[3 * pt->vertex] - geo->px[pt->vertex]) * geo->step;
+    got[1] = (double)(x[3 * pt->vertex + 1] - geo->py[pt->vertex]) * geo->step;
+    got[2] = (double)(x[3 * pt->vertex + 2] - geo->pz[pt->vertex]) * geo->step;
+    for (k = 0; k < 3; ++k) along += got[k] * want[k] / len, off += (got[k] - want[k]) * (got[k] - want[k]);
+    fm->share[pt->group][fm->count[pt->group]] = along / len;
+    fm->error[pt->group][fm->count[pt->group]++] = sqrt(off) / len;
+  }
+}
+
+static int compare_double(const void *a, const void *b);
+
+static void fdp_motion_print(fdp_motion *fm) {
+  static const char *names[12] = {"",      "",     "inner lip, chin, jaw", "eyes",  "brows", "cheeks",
+                                  "tongue", "head", "outer lip",            "nose",  "ears",  "hair"};
+  uint32_t g, n;
+  printf("FDP motion against the stream's prescription (where it is at least MNS0 / 20):\n");
+  printf("  group                    samples  reached (median)  off by (median)  reached (90th pct)\n");
+  for (g = 1; g < 12; ++g) {
+    n = fm->count[g];
+    if (!n) continue;
+    qsort(fm->share[g], n, sizeof(double), compare_double);
+    qsort(fm->error[g], n, sizeof(double), compare_double);
+    printf("  %2u %-21s %8lu  %15.1f %%  %14.1f %%  %16.1f %%\n", (unsigned)g, names[g], (unsigned long)n,
+           100 * fm->share[g][n / 2], 100 * fm->error[g][n / 2], 100 * fm->share[g][n * 9 / 10]);
+  }
+}
+
 static int compare_double(const void *a, const void *b) {
   double x = *(const double *)a, y = *(const double *)b;
   return x < y ? -1 : x > y;
@@ -150,7 +250,7 @@ static int compare_double(const void *a, const void *b) {
 int main(int argc, char **argv) {
   const char *model_path = NULL, *stream_path = NULL, *obj_dir = NULL;
   unsigned long fps = 0;
-  int stats = 0, quiet = 0, i;
+  int stats = 0, quiet = 0, motion = 0, i;
   uint32_t mirror = 0, frame_count = 0, rendered = 0, k;
   afm_player_options po;
   uint8_t *model_data = NULL, *stream_data = NULL;
@@ -160,8 +260,9 @@ int main(int argc, char **argv) {
   afm_fap_header header;
   afm_fap_stats fap_stats;
   afm_fap_cursor cursor;
-  afm_player *player = NULL;
-  void *player_memory = NULL;
+  afm_player *player = NULL, *still = NULL;
+  void *player_memory = NULL, *still_memory = NULL;
+  fdp_motion fm;
   double *times = NULL;
   afm_diag diag;
   afm_read_options ro;
@@ -195,6 +296,8 @@ int main(int argc, char **argv) {
       }
     } else if (!strcmp(a, "--stats")) {
       stats = 1;
+    } else if (!strcmp(a, "--fdp-motion")) {
+      motion = 1;
     } else if (!strcmp(a, "--quiet")) {
       quiet = 1;
     } else if (!strcmp(a, "--normal-deltas")) {
@@ -216,6 +319,7 @@ int main(int argc, char **argv) {
     return 2;
   }
 
+  memset(&fm, 0, sizeof fm);
   memset(&diag, 0, sizeof diag);
   if (afm_file_read(model_path, NULL, &model_data, &model_size) != AFM_OK) {
     fprintf(stderr, "afm-play: %s: cannot read: %s\n", model_path, strerror(errno));
@@ -260,6 +364,19 @@ int main(int argc, char **argv) {
     if (!player_memory) r = AFM_ERR_OUT_OF_MEMORY;
   }
   if (r == AFM_OK) r = afm_player_init(doc, &po, player_memory, player_bytes, &player);
+  if (r == AFM_OK && motion) {
+    /* The FDPs' motion is measured in the head's frame: a second player
+       that leaves the head's rigid motion out. */
+    afm_player_options head = po;
+    size_t bytes = 0;
+    head.flags |= AFM_PLAYER_HEAD_MATRIX;
+    r = afm_player_measure(doc, &head, &bytes);
+    if (r == AFM_OK) {
+      still_memory = malloc(bytes);
+      if (!still_memory) r = AFM_ERR_OUT_OF_MEMORY;
+    }
+    if (r == AFM_OK) r = afm_player_init(doc, &head, still_memory, bytes, &still);
+  }
   if (r == AFM_OK) r = afm_fap_cursor_init(&cursor, frames, frame_count, header.fps_num, header.fps_den, mirror);
   if (r != AFM_OK) {
     fprintf(stderr, "afm-play: %s: cannot play: %s%s\n", model_path, afm_result_string(r),
@@ -277,7 +394,7 @@ int main(int argc, char **argv) {
     /* Render times: the stream's own frames, or a resampled clock. */
     uint32_t total = fps ? (uint32_t)(duration_us * fps / 1000000u) + 1 : frame_count;
     times = (double *)malloc(total * sizeof *times);
-    if (!times) {
+    if (!times || (motion && !fdp_motion_init(&fm, doc, total))) {
       fprintf(stderr, "afm-play: out of memory\n");
       goto done;
     }
@@ -305,6 +422,14 @@ int main(int argc, char **argv) {
                (double)t_us * 1e-6, (unsigned long)info->active_targets, (unsigned long)info->updates,
                (unsigned long long)pose_hash(player, doc->geometry.vertex_count));
       if (obj_dir && !write_obj(obj_dir, k, doc, player)) goto done;
+      if (still) {
+        r = afm_player_pose(still, a, b, t);
+        if (r != AFM_OK) {
+          fprintf(stderr, "afm-play: frame %lu: %s\n", (unsigned long)k, afm_result_string(r));
+          goto done;
+        }
+        fdp_motion_add(&fm, doc, still, a, b, t);
+      }
       ++rendered;
     }
   }
@@ -323,9 +448,12 @@ int main(int argc, char **argv) {
     printf("stream: %lu values clamped, %lu with fractions rounded\n", (unsigned long)fap_stats.clamped,
            (unsigned long)fap_stats.rounded);
   }
+  if (motion) fdp_motion_print(&fm);
   status = 0;
 done:
+  fdp_motion_free(&fm);
   free(times);
+  free(still_memory);
   free(player_memory);
   free(frames);
   free(stream_data);

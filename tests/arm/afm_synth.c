@@ -58,17 +58,6 @@ static void *xcalloc(size_t n, size_t size) {
   return p;
 }
 
-static double fapu_distance(const afm_meta *m, afm_fapu unit) {
-  switch (unit) {
-    case AFM_FAPU_IRISD: return m->irisd0;
-    case AFM_FAPU_ES: return m->es0;
-    case AFM_FAPU_ENS: return m->ens0;
-    case AFM_FAPU_MNS: return m->mns0;
-    case AFM_FAPU_MW: return m->mw0;
-    default: return 0;
-  }
-}
-
 /* The skin vertex of FDP group.index, or -1. */
 static long fdp_vertex(const synth *s, int group, int index) {
   const afm_meta *m = &s->in->meta;
@@ -182,7 +171,7 @@ static void fap_targets(synth *s) {
     c = fdp_vertex(s, info->fdp_group, info->fdp_index);
     if (c < 0) continue;
     /* 256 FAP units = 0.25 FAPU distance; the bump moves 0.1 of it. */
-    amp = 0.1 * fapu_distance(&s->in->meta, info->unit) / s->in->geometry.step;
+    amp = 0.1 * afm_meta_fapu_x0(&s->in->meta, info->unit) / s->in->geometry.step;
     for (k = 0; k < 3; ++k) {
       d[k] = amp * info->direction[k];
       n[k] = -3000.0 * info->direction[k];

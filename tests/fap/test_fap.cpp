@@ -23,6 +23,7 @@
 #include "core/part_kind.h"
 #include "core/fapu.h"
 #include "fap/fap_mapping.h"
+#include "fap/fap_partition.h"
 #include "fap/fap_synthesis.h"
 #include "io/load_face.h"
 #include "refhead/refhead.h"
@@ -643,12 +644,140 @@ TEST(FapSynthesis, AFapThatIsTheSameSolveAsAnotherCopiesItsTarget) {
   ASSERT_EQ(alone->targets.size(), 1u);
   const size_t skin = static_cast<size_t>(m.skin);
   EXPECT_EQ(both->targets[1].number, 59);
-  EXPECT_EQ(both->targets[1].displacement[skin], alone->targets[0].displacement[skin]);
+  // Made together, the two share the corner (fap_partition.h): each holds
+  // half of the solve, exactly (phi / (phi + phi)).
+  const Eigen::MatrixXd twice = 2 * both->targets[1].displacement[skin];
+  EXPECT_EQ(twice, alone->targets[0].displacement[skin]);
   EXPECT_EQ(both->targets[1].displacement[skin], both->targets[0].displacement[skin]);
   EXPECT_EQ(both->outcomes[1].seconds, 0) << "solved again instead of copied";
   EXPECT_GT(both->outcomes[0].seconds, 0);
   EXPECT_EQ(both->outcomes[1].reference, 150);
   EXPECT_EQ(both->outcomes[1].achieved, alone->outcomes[0].achieved);
+}
+
+// The partition itself (fap_partition.h), on points: targets linked through
+// shared muscles contracted the same way, a partition of unity over the
+// FAPs of a linked set, each FAP's weight 1 at its own FDP, equal shares
+// where FDPs coincide with one direction, each its whole point where they
+// coincide with different directions, and the two sides of one FAP counted
+// once.
+TEST(FapPartition, LinkedTargetsSplitThePointsAndEachFapCountsOnce) {
+  Eigen::MatrixXd X(6, 3);
+  X << 0, 0, 0,  //
+      4, 0, 0,   //
+      8, 0, 0,   //
+      2, 3, 0,   //
+      6, -1, 2,  //
+      20, 0, 0;
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitY(), right = -Eigen::Vector3d::UnitX();
+  std::vector<SharingTarget> t(6);
+  t[0] = {4, 0, up, {{"a", +1}}};              // FAP 4 at point 0
+  t[1] = {51, 1, up, {{"a", +1}, {"b", +1}}};  // linked to 4 by a, to 8 by b
+  t[2] = {8, 2, up, {{"b", +1}}};
+  t[3] = {4, 0, up, {{"a", -1}}};              // FAP 4's other side: a the other way
+  t[4] = {59, 0, up, {{"a", -1}}};             // the same point as FAP 4, linked to its other side
+  t[5] = {9, 5, up, {{"c", +1}}};              // alone
+  const FapPartition p = partition_shared_targets(X, t);
+  EXPECT_EQ(p.component[0], p.component[1]);
+  EXPECT_EQ(p.component[1], p.component[2]);
+  EXPECT_NE(p.component[0], p.component[3]) << "a contracted the other way is another motion";
+  EXPECT_EQ(p.component[3], p.component[4]);
+  EXPECT_NE(p.component[5], p.component[0]);
+  EXPECT_EQ(p.weight[5].size(), 0) << "a target alone keeps its pose";
+  for (int k = 0; k < 5; ++k) ASSERT_EQ(p.weight[static_cast<size_t>(k)].size(), X.rows()) << k;
+  for (Eigen::Index v = 0; v < X.rows(); ++v) {
+    EXPECT_NEAR(p.weight[0](v) + p.weight[1](v) + p.weight[2](v), 1, 1e-12) << v;
+    EXPECT_NEAR(p.weight[3](v) + p.weight[4](v), 1, 1e-12) << v;
+    for (int k = 0; k < 5; ++k) EXPECT_TRUE(p.weight[static_cast<size_t>(k)](v) >= 0) << k;
+  }
+  EXPECT_NEAR(p.weight[0](0), 1, 1e-9);
+  EXPECT_NEAR(p.weight[1](1), 1, 1e-9);
+  EXPECT_NEAR(p.weight[2](2), 1, 1e-9);
+  EXPECT_NEAR(p.weight[1](0), 0, 1e-9);
+  EXPECT_EQ(p.weight[3](0), 0.5) << "coincident FDPs share equally";
+  EXPECT_EQ(p.weight[4](0), 0.5);
+  // Nearer FDPs weigh more: point 4 lies between FAP 51's and FAP 8's.
+  EXPECT_GT(p.weight[1](4) + p.weight[2](4), p.weight[0](4));
+  // Both sides of one FAP in one set (linked through another FAP): each
+  // side gets the FAP's whole share, as only one plays at a time.
+  std::vector<SharingTarget> u = {{64, 0, right, {{"l", +1}, {"r", -1}}},
+                                  {64, 0, right, {{"r", +1}, {"l", -1}}},
+                                  {61, 1, up, {{"l", +1}, {"r", +1}}}};
+  const FapPartition q = partition_shared_targets(X, u);
+  EXPECT_EQ(q.component[0], q.component[1]);
+  for (Eigen::Index v = 0; v < X.rows(); ++v) {
+    EXPECT_EQ(q.weight[0](v), q.weight[1](v));
+    EXPECT_NEAR(q.weight[0](v) + q.weight[2](v), 1, 1e-12);
+  }
+  // FAPs of one FDP with different directions (63 raises the nose tip, 64
+  // bends it) each keep that point whole; a third FAP still shares with both.
+  std::vector<SharingTarget> nose = {{63, 0, up, {{"l", +1}, {"r", +1}}},
+                                     {64, 0, right, {{"l", +1}, {"r", -1}}},
+                                     {61, 2, up, {{"l", +1}}}};
+  const FapPartition r = partition_shared_targets(X, nose);
+  EXPECT_EQ(r.component[0], r.component[2]);
+  EXPECT_NEAR(r.weight[0](0), 1, 1e-9);
+  EXPECT_NEAR(r.weight[1](0), 1, 1e-9);
+  EXPECT_NEAR(r.weight[2](2), 1, 1e-9);
+  for (Eigen::Index v = 0; v < X.rows(); ++v) {
+    EXPECT_NEAR(r.weight[0](v) + r.weight[2](v), 1, 1e-12) << v;
+    EXPECT_NEAR(r.weight[1](v) + r.weight[2](v), 1, 1e-12) << v;
+  }
+}
+
+// Real streams send the inner and outer lip FAPs together at equal values.
+// FAPs 12 and 59 (the inner and outer corner raised) are both zygomaticus
+// major left: put 59's FDP 8.3 on another vertex of the upper lip (on the
+// reference head it is 2.4's vertex) and make them together. Their targets
+// add up to a blend of the two solo targets, each FDP moving by its own
+// FAP's motion (summed as they were, both FDPs moved by about both motions),
+// and each alone is its solo target weighted by a share in [0, 1].
+TEST(FapSynthesis, FapsSharingAMuscleSplitTheSkinBetweenTheirFdps) {
+  const Built &b = head_1k();
+  FaceModel m = b.model;
+  const FdpPoint *corner = m.fdps.find(FdpId{2, 4}, m.skin);
+  const FdpPoint *lip = m.fdps.find(FdpId{8, 5}, m.skin);  // the outer upper lip, left
+  ASSERT_TRUE(corner && lip && corner->part == m.skin && lip->part == m.skin);
+  ASSERT_NE(corner->vertex, lip->vertex);
+  const FdpPoint moved = *lip;
+  for (FdpPoint &p : m.fdps.points)
+    if (p.id == FdpId{8, 3}) p.part = moved.part, p.vertex = moved.vertex, p.pos = moved.pos;
+  FapSynthesisOptions o;
+  o.negative_sides = false;
+  o.only = {12, 59};
+  Expected<FapSynthesis> both = synthesize_faps(b.head.scene, m, o);
+  o.only = {12};
+  Expected<FapSynthesis> inner = synthesize_faps(b.head.scene, m, o);
+  o.only = {59};
+  Expected<FapSynthesis> outer = synthesize_faps(b.head.scene, m, o);
+  ASSERT_TRUE(both.is_ok() && inner.is_ok() && outer.is_ok());
+  ASSERT_EQ(both->targets.size(), 2u);
+  ASSERT_EQ(inner->targets.size(), 1u);
+  ASSERT_EQ(outer->targets.size(), 1u);
+  const size_t skin = static_cast<size_t>(m.skin);
+  const Eigen::MatrixXd &a = inner->targets[0].displacement[skin], &c = outer->targets[0].displacement[skin];
+  const Eigen::MatrixXd sum = both->targets[0].displacement[skin] + both->targets[1].displacement[skin];
+  const Eigen::Vector3d up = direction_of(12);
+  const int v12 = corner->vertex, v59 = moved.vertex;
+  // The solo targets move both FDPs (59's pose takes the corner up by over
+  // a fifth of 12's): the partition has something to undo.
+  ASSERT_GT(c.row(v12).dot(up), 0.2 * a.row(v12).dot(up));
+  ASSERT_GT(a.row(v59).dot(up), 0);
+  EXPECT_NEAR(sum.row(v12).dot(up), a.row(v12).dot(up), 1e-9);
+  EXPECT_NEAR(sum.row(v59).dot(up), c.row(v59).dot(up), 1e-9);
+  for (Eigen::Index v = 0; v < sum.rows(); ++v)
+    ASSERT_LE((sum.row(v) - a.row(v)).norm(), (c.row(v) - a.row(v)).norm() + 1e-12) << "vertex " << v;
+  for (int k = 0; k < 2; ++k) {
+    const Eigen::MatrixXd &solo = k == 0 ? a : c, &part = both->targets[static_cast<size_t>(k)].displacement[skin];
+    for (Eigen::Index v = 0; v < part.rows(); ++v) {
+      const double w = solo.row(v).squaredNorm() > 0 ? part.row(v).dot(solo.row(v)) / solo.row(v).squaredNorm() : 0;
+      ASSERT_TRUE(w >= -1e-12 && w <= 1 + 1e-12) << "FAP " << (k ? 59 : 12) << " vertex " << v << " share " << w;
+      ASSERT_LE((part.row(v) - w * solo.row(v)).norm(), 1e-12 * (1 + solo.row(v).norm()));
+    }
+  }
+  // Measured at its own FDP, as made alone.
+  EXPECT_NEAR(both->outcomes[0].achieved.dot(up), inner->outcomes[0].achieved.dot(up), 1e-9);
+  EXPECT_NEAR(both->outcomes[1].achieved.dot(up), outer->outcomes[0].achieved.dot(up), 1e-9);
 }
 
 // The simulation mesh (anatomy/sim_mesh.h) against the skin itself: the

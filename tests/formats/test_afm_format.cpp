@@ -105,6 +105,20 @@ TEST(AfmFormat, RawRoundTripKeepsEveryField) {
   EXPECT_EQ(write_doc(*doc, AFM_PROFILE_RAW), bytes);
 }
 
+// Each distance unit reads its own X0 (distinct values, so a swap shows);
+// angles and the high-level FAPs have none.
+TEST(AfmFormat, EachFapUnitReadsItsOwnDistance) {
+  afm_meta m{};
+  m.es0 = 1, m.irisd0 = 2, m.ens0 = 3, m.mns0 = 4, m.mw0 = 5;
+  EXPECT_EQ(afm_meta_fapu_x0(&m, AFM_FAPU_ES), 1);
+  EXPECT_EQ(afm_meta_fapu_x0(&m, AFM_FAPU_IRISD), 2);
+  EXPECT_EQ(afm_meta_fapu_x0(&m, AFM_FAPU_ENS), 3);
+  EXPECT_EQ(afm_meta_fapu_x0(&m, AFM_FAPU_MNS), 4);
+  EXPECT_EQ(afm_meta_fapu_x0(&m, AFM_FAPU_MW), 5);
+  EXPECT_EQ(afm_meta_fapu_x0(&m, AFM_FAPU_AU), 0);
+  EXPECT_EQ(afm_meta_fapu_x0(&m, AFM_FAPU_NONE), 0);
+}
+
 TEST(AfmFormat, BufferApiMatchesAllocatingApi) {
   SyntheticDoc s;
   std::vector<uint8_t> bytes = write_doc(*make_synthetic_doc(s), AFM_PROFILE_RAW);

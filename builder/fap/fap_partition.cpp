@@ -1,0 +1,89 @@
+#include "fap/fap_partition.h"
+
+#include <algorithm>
+#include <numeric>
+
+namespace afmb {
+
+FapPartition partition_shared_targets(const Eigen::MatrixXd &X, const std::vector<SharingTarget> &targets) {
+  const size_t n = targets.size();
+  std::vector<size_t> parent(n);
+  std::iota(parent.begin(), parent.end(), size_t{0});
+  auto root = [&parent](size_t k) {
+    while (parent[k] != k) k = parent[k] = parent[parent[k]];
+    return k;
+  };
+  auto usable = [&targets, &X](size_t k) {
+    return targets[k].vertex >= 0 && targets[k].vertex < X.rows() && !targets[k].muscles.empty();
+  };
+  for (size_t a = 0; a < n; ++a)
+    for (size_t b = a + 1; b < n && usable(a); ++b) {
+      if (!usable(b)) continue;
+      bool shared = false;
+      for (const auto &m : targets[a].muscles)
+        shared |= std::find(targets[b].muscles.begin(), targets[b].muscles.end(), m) != targets[b].muscles.end();
+      if (shared) parent[root(a)] = root(b);
+    }
+  FapPartition out;
+  out.component.assign(n, -1);
+  out.weight.assign(n, Eigen::VectorXd());
+  std::vector<int> id(n, -1);
+  int next = 0;
+  for (size_t k = 0; k < n; ++k) {
+    const size_t r = root(k);
+    if (id[r] < 0) id[r] = next++;
+    out.component[k] = id[r];
+  }
+  for (int c = 0; c < next; ++c) {
+    std::vector<size_t> members;
+    for (size_t k = 0; k < n; ++k)
+      if (out.component[k] == c && usable(k)) members.push_back(k);
+    if (members.size() < 2) continue;
+    Eigen::Vector3d lo = X.row(targets[members[0]].vertex).transpose(), hi = lo;
+    for (size_t k : members) {
+      lo = lo.cwiseMin(X.row(targets[k].vertex).transpose());
+      hi = hi.cwiseMax(X.row(targets[k].vertex).transpose());
+    }
+    const double h = 1e-6 * std::max((hi - lo).norm(), 1e-12), h2 = h * h;
+    // phi per distinct FDP vertex; at each vertex, the FAPs (each once:
+    // both sides of one FAP share its FDP and never play together) counted
+    // per direction.
+    std::vector<int> vertices;
+    for (size_t k : members)
+      if (std::find(vertices.begin(), vertices.end(), targets[k].vertex) == vertices.end())
+        vertices.push_back(targets[k].vertex);
+    Eigen::MatrixXd phi(X.rows(), static_cast<Eigen::Index>(vertices.size()));
+    for (size_t u = 0; u < vertices.size(); ++u) {
+      const Eigen::RowVector3d p = X.row(vertices[u]);
+      phi.col(static_cast<Eigen::Index>(u)) = ((X.rowwise() - p).rowwise().squaredNorm().array() + h2).inverse().matrix();
+    }
+    auto count = [&](int vertex, const Eigen::Vector3d &direction) {
+      std::vector<int> faps;
+      for (size_t k : members)
+        if (targets[k].vertex == vertex && targets[k].direction == direction &&
+            std::find(faps.begin(), faps.end(), targets[k].fap) == faps.end())
+          faps.push_back(targets[k].fap);
+      return static_cast<double>(faps.size());
+    };
+    // Another vertex counts as its largest direction class (63 and 64 at the
+    // nose tip are one point for FAP 61; 12 and 59 at the corner two
+    // shares); k's own vertex as k's class.
+    std::vector<double> largest(vertices.size(), 0);
+    for (size_t u = 0; u < vertices.size(); ++u)
+      for (size_t k : members)
+        if (targets[k].vertex == vertices[u]) largest[u] = std::max(largest[u], count(vertices[u], targets[k].direction));
+    for (size_t k : members) {
+      Eigen::VectorXd sum = Eigen::VectorXd::Zero(X.rows());
+      Eigen::Index own = 0;
+      for (size_t u = 0; u < vertices.size(); ++u) {
+        const bool mine = vertices[u] == targets[k].vertex;
+        if (mine) own = static_cast<Eigen::Index>(u);
+        sum += (mine ? count(vertices[u], targets[k].direction) : largest[u]) * phi.col(static_cast<Eigen::Index>(u));
+      }
+      out.weight[k] = phi.col(own).cwiseQuotient(sum);
+    }
+  }
+  return out;
+}
+
+}  // namespace afmb

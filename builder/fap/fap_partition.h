@@ -1,0 +1,68 @@
+// FAP targets that share a muscle split the skin between them, so that a
+// stream sending them together moves each FDP once.
+//
+// Why: the builder makes a FAP's target from its muscle group's pose, and
+// the pose moves everything the muscles move. FAPs 4 and 51 (the inner and
+// the outer upper lip's midpoint) are both made of the two upper lip
+// muscles; FAPs 12 and 59 (the inner and outer corner raised) both of
+// zygomaticus major. Real streams send the inner and the outer lip FAPs
+// together, with equal values (both of ../shared/data's toolkits do). Summed
+// as they were, Song's corner rose twice the prescribed motion and its outer
+// upper lip four times (afm-play on Song, 4 + 51 at their references).
+//
+// The rule: targets are linked when their muscle groups share a muscle
+// contracted the same way (a positive-side target of one FAP and a
+// negative-side one of another may be linked: both are poses of that
+// muscle). A linked set (a connected component of that relation) splits the
+// skin by Shepard's inverse-distance weights on its members' FDPs,
+//
+//     w_k(x) = phi_k(x) / sum_j phi_j(x),   phi_k(x) = 1 / (|x - p_k|^2 + h^2),
+//
+// the sum over the set's FAPs, each once (both sides of one FAP share an FDP
+// and are never active together). That is a partition of unity over the
+// FAPs a stream can send together: at equal values the members' targets add
+// up to a blend of their poses in which every member's FDP moves by its own
+// target's motion there. Alone, a member moves its own region: FAP 4 the
+// inner upper lip's middle (the lip grows thinner), as MPEG-4 defines it.
+// h is a millionth of the set's span, so w_k(p_k) = 1 to about 1e-12 for
+// distinct FDPs.
+//
+// Members whose FDPs are one vertex and whose FAPs have one direction (the
+// inner and outer lip corners, 2.4 and 8.3, on Song and on the reference
+// head) get equal shares there: each moves the corner by half its motion,
+// and the two together by all of it. FAPs of one FDP with different
+// directions (63 raises the nose tip, 64 bends it) are different motions of
+// that point: neither counts in the other's sum, so each keeps the whole of
+// it (near it, the two together may weigh more than one: raise and bend),
+// and in a third FAP's sum the point counts as its largest direction class
+// (once for the nose tip, twice for the corners).
+//
+// The eyelid FAPs (19-22) are left out: their targets already split
+// orbicularis oculi's pose between the two lids (fap_synthesis.cpp).
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace afmb {
+
+struct SharingTarget {
+  int fap = 0;      // its FAP: the sides of one FAP count once in a set's sum
+  int vertex = -1;  // its FDP's vertex on the mesh the weights are for
+  Eigen::Vector3d direction = Eigen::Vector3d::Zero();  // its FAP's positive direction
+  // The muscles of its group, each with the sign of its contraction (+1, -1).
+  std::vector<std::pair<std::string, int>> muscles;
+};
+
+struct FapPartition {
+  std::vector<int> component;        // per target: its linked set (0, 1, ...)
+  std::vector<Eigen::VectorXd> weight;  // per target: #V weights in [0, 1]; empty when alone
+};
+
+// X: #V x 3 rest positions (model units). Targets with vertex < 0 or no
+// muscle are alone.
+FapPartition partition_shared_targets(const Eigen::MatrixXd &X, const std::vector<SharingTarget> &targets);
+
+}  // namespace afmb
