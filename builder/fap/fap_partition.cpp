@@ -1,11 +1,45 @@
 #include "fap/fap_partition.h"
 
 #include <algorithm>
+#include <limits>
 #include <numeric>
+#include <queue>
 
 namespace afmb {
 
-FapPartition partition_shared_targets(const Eigen::MatrixXd &X, const std::vector<SharingTarget> &targets) {
+namespace {
+
+// Path lengths over the mesh's edges from vertex `from` (Dijkstra), #V:
+// across the mouth the lips are far apart even where they touch.
+Eigen::VectorXd path_distances(const Eigen::MatrixXd &X, const std::vector<std::vector<int>> &adj, int from) {
+  Eigen::VectorXd d = Eigen::VectorXd::Constant(X.rows(), std::numeric_limits<double>::infinity());
+  using Item = std::pair<double, int>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> q;
+  d(from) = 0;
+  q.push({0.0, from});
+  while (!q.empty()) {
+    const auto [dv, v] = q.top();
+    q.pop();
+    if (dv > d(v)) continue;
+    for (int w : adj[static_cast<size_t>(v)]) {
+      const double dw = dv + (X.row(v) - X.row(w)).norm();
+      if (dw < d(w)) d(w) = dw, q.push({dw, w});
+    }
+  }
+  return d;
+}
+
+}  // namespace
+
+FapPartition partition_shared_targets(const Eigen::MatrixXd &X, const Eigen::MatrixXi &F,
+                                      const std::vector<SharingTarget> &targets) {
+  std::vector<std::vector<int>> adj(static_cast<size_t>(X.rows()));
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = F(f, k), b = F(f, (k + 1) % 3);
+      adj[static_cast<size_t>(a)].push_back(b);
+      adj[static_cast<size_t>(b)].push_back(a);
+    }
   const size_t n = targets.size();
   std::vector<size_t> parent(n);
   std::iota(parent.begin(), parent.end(), size_t{0});
@@ -22,7 +56,17 @@ FapPartition partition_shared_targets(const Eigen::MatrixXd &X, const std::vecto
       bool shared = false;
       for (const auto &m : targets[a].muscles)
         shared |= std::find(targets[b].muscles.begin(), targets[b].muscles.end(), m) != targets[b].muscles.end();
-      if (shared) parent[root(a)] = root(b);
+      // Or one's target moves the other's FDP along the other's motion by
+      // more than kFapOverlap of the other's own target there.
+      auto overlaps = [&targets](size_t i, size_t j) {
+        const SharingTarget &ti = targets[i], &tj = targets[j];
+        if (!ti.displacement || !tj.displacement || ti.fap == tj.fap) return false;
+        const Eigen::Vector3d along = tj.side * tj.direction;
+        const double own = tj.displacement->row(tj.vertex).dot(along.transpose());
+        const double cross = ti.displacement->row(tj.vertex).dot(along.transpose());
+        return own > 0 && cross > kFapOverlap * own;
+      };
+      if (shared || overlaps(a, b) || overlaps(b, a)) parent[root(a)] = root(b);
     }
   FapPartition out;
   out.component.assign(n, -1);
@@ -54,9 +98,16 @@ FapPartition partition_shared_targets(const Eigen::MatrixXd &X, const std::vecto
         vertices.push_back(targets[k].vertex);
     Eigen::MatrixXd phi(X.rows(), static_cast<Eigen::Index>(vertices.size()));
     for (size_t u = 0; u < vertices.size(); ++u) {
-      const Eigen::RowVector3d p = X.row(vertices[u]);
-      phi.col(static_cast<Eigen::Index>(u)) = ((X.rowwise() - p).rowwise().squaredNorm().array() + h2).inverse().matrix();
+      const Eigen::VectorXd d = F.rows() > 0 ? path_distances(X, adj, vertices[u])
+                                             : (X.rowwise() - X.row(vertices[u])).rowwise().norm().eval();
+      phi.col(static_cast<Eigen::Index>(u)) = (d.array().square() + h2).inverse().matrix();
     }
+    // A vertex that no FDP's path reaches (not in the mesh, or on another
+    // piece of it) takes straight distances.
+    for (Eigen::Index v = 0; v < X.rows(); ++v)
+      if (!(phi.row(v).sum() > 0))
+        for (size_t u = 0; u < vertices.size(); ++u)
+          phi(v, static_cast<Eigen::Index>(u)) = 1 / ((X.row(v) - X.row(vertices[u])).squaredNorm() + h2);
     auto count = [&](int vertex, const Eigen::Vector3d &direction) {
       std::vector<int> faps;
       for (size_t k : members)

@@ -1,31 +1,38 @@
-// FAP targets that share a muscle split the skin between them, so that a
+// FAP targets that move the same skin split it between them, so that a
 // stream sending them together moves each FDP once.
 //
 // Why: the builder makes a FAP's target from its muscle group's pose, and
 // the pose moves everything the muscles move. FAPs 4 and 51 (the inner and
 // the outer upper lip's midpoint) are both made of the two upper lip
 // muscles; FAPs 12 and 59 (the inner and outer corner raised) both of
-// zygomaticus major. Real streams send the inner and the outer lip FAPs
-// together, with equal values (both of ../shared/data's toolkits do). Summed
-// as they were, Song's corner rose twice the prescribed motion and its outer
-// upper lip four times (afm-play on Song, 4 + 51 at their references).
+// zygomaticus major; frontalis inner, major and outer each raise the whole
+// brow. Real streams send such FAPs together, the inner and outer lip ones
+// with equal values (both of ../shared/data's toolkits do). Summed as they
+// were, Song's corner rose twice the prescribed motion and its outer upper
+// lip four times (afm-play on Song, 4 + 51 at their references), and
+// Xface's fear.fap raised its brows twice as far as it asks.
 //
-// The rule: targets are linked when their muscle groups share a muscle
+// The rule: two targets are linked when their muscle groups share a muscle
 // contracted the same way (a positive-side target of one FAP and a
 // negative-side one of another may be linked: both are poses of that
-// muscle). A linked set (a connected component of that relation) splits the
-// skin by Shepard's inverse-distance weights on its members' FDPs,
+// muscle), or when one's target moves the other's FDP along the other's
+// motion by more than kFapOverlap of the other's own target there (the
+// brows; 41's zygomatici and the lower lip). A linked set (a connected
+// component) splits the skin by Shepard's inverse-distance weights on its
+// members' FDPs,
 //
-//     w_k(x) = phi_k(x) / sum_j phi_j(x),   phi_k(x) = 1 / (|x - p_k|^2 + h^2),
+//     w_k(x) = phi_k(x) / sum_j phi_j(x),   phi_k(x) = 1 / (d(x, p_k)^2 + h^2),
 //
-// the sum over the set's FAPs, each once (both sides of one FAP share an FDP
-// and are never active together). That is a partition of unity over the
-// FAPs a stream can send together: at equal values the members' targets add
-// up to a blend of their poses in which every member's FDP moves by its own
-// target's motion there. Alone, a member moves its own region: FAP 4 the
-// inner upper lip's middle (the lip grows thinner), as MPEG-4 defines it.
-// h is a millionth of the set's span, so w_k(p_k) = 1 to about 1e-12 for
-// distinct FDPs.
+// d the length of the shortest path along the mesh's edges (the lips are
+// far apart across the mouth even where they touch: on the reference head
+// the inner lips' FDPs lie on one point of two vertices), the sum over the
+// set's FAPs, each once (both sides of one FAP share an FDP and are never
+// active together). That is a partition of unity over the FAPs a stream can
+// send together: at equal values the members' targets add up to a blend of
+// their poses in which every member's FDP moves by its own target's motion
+// there. Alone, a member moves its own region: FAP 4 the inner upper lip's
+// middle (the lip grows thinner), as MPEG-4 defines it. h is a millionth of
+// the set's span, so w_k(p_k) = 1 to about 1e-12 for distinct FDPs.
 //
 // Members whose FDPs are one vertex and whose FAPs have one direction (the
 // inner and outer lip corners, 2.4 and 8.3, on Song and on the reference
@@ -48,10 +55,19 @@
 
 namespace afmb {
 
+// The overlap that links two targets of different muscles (see above).
+// Measured with afm-play --fdp-motion on seven of the real streams, summing
+// the median distance from the prescription over streams and FDP groups:
+// 16 % less than linking by shared muscles alone on Song, 10 % less on the
+// 2k head (a half or a tenth of the own motion not tried).
+constexpr double kFapOverlap = 0.25;
+
 struct SharingTarget {
   int fap = 0;      // its FAP: the sides of one FAP count once in a set's sum
   int vertex = -1;  // its FDP's vertex on the mesh the weights are for
   Eigen::Vector3d direction = Eigen::Vector3d::Zero();  // its FAP's positive direction
+  int side = +1;                                        // its target's side of the FAP
+  const Eigen::MatrixXd *displacement = nullptr;        // #V x 3, its target (null: no overlap test)
   // The muscles of its group, each with the sign of its contraction (+1, -1).
   std::vector<std::pair<std::string, int>> muscles;
 };
@@ -61,8 +77,10 @@ struct FapPartition {
   std::vector<Eigen::VectorXd> weight;  // per target: #V weights in [0, 1]; empty when alone
 };
 
-// X: #V x 3 rest positions (model units). Targets with vertex < 0 or no
-// muscle are alone.
-FapPartition partition_shared_targets(const Eigen::MatrixXd &X, const std::vector<SharingTarget> &targets);
+// X: #V x 3 rest positions (model units); F: #F x 3 triangles over them
+// (empty: straight distances). Targets with vertex < 0 or no muscle are
+// alone.
+FapPartition partition_shared_targets(const Eigen::MatrixXd &X, const Eigen::MatrixXi &F,
+                                      const std::vector<SharingTarget> &targets);
 
 }  // namespace afmb

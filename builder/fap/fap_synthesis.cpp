@@ -623,7 +623,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       r.target->reference = r.outcome.reference;
     }
   }
-  // FAP targets whose groups share a muscle split the skin (fap_partition.h).
+  // FAP targets that move the same skin split it (fap_partition.h).
   {
     std::vector<SharingTarget> sharing(work.size());
     std::vector<Eigen::Vector3d> dirs(work.size(), Eigen::Vector3d::Zero());
@@ -639,8 +639,10 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         sharing[k].muscles.push_back({c.muscle, c.percent > 0 ? +1 : -1});
       dirs[k] = fap_direction(info);
       sharing[k].direction = dirs[k];
+      sharing[k].side = work[k].side;
+      sharing[k].displacement = &results[k].target->displacement[static_cast<size_t>(model.skin)];
     }
-    const FapPartition part = partition_shared_targets(skin.X0.topRows(skin.n), sharing);
+    const FapPartition part = partition_shared_targets(skin.X0.topRows(skin.n), skin.F, sharing);
     const size_t sk = static_cast<size_t>(model.skin);
     for (size_t k = 0; k < work.size(); ++k) {
       if (part.weight[k].size() == 0) continue;

@@ -11,10 +11,10 @@
 // the pose of the largest motion solved so far not past its own); the jaw's rigid parts
 // (lower teeth, tongue) get a control with the same motion.
 //
-// FAP targets whose groups share a muscle (the inner and outer lip FAPs,
-// the midlip and mid-left/right ones, ...) then split the skin between them
-// (fap_partition.h), so that a stream sending them together moves each FDP
-// once; the outcomes are measured on the split targets.
+// FAP targets that move the same skin (the inner and outer lip FAPs, the
+// midlip and mid-left/right ones, the brows, ...) then split it between
+// them (fap_partition.h), so that a stream sending them together moves each
+// FDP once; the outcomes are measured on the split targets.
 //
 // Every target also carries the parts that ride on the skin (lashes, lid
 // and brow strips: skin_binding.h), by the skin's displacement under them.

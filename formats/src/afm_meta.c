@@ -83,7 +83,7 @@ afm_result afm_meta_encode(const afm_meta *meta, afm_writer *w) {
   return w->overflow ? AFM_ERR_BUFFER_TOO_SMALL : AFM_OK;
 }
 
-double afm_meta_fapu_x0(const afm_meta *meta, afm_fapu unit) {
+float afm_meta_fapu_x0(const afm_meta *meta, afm_fapu unit) {
   switch (unit) {
     case AFM_FAPU_IRISD: return meta->irisd0;
     case AFM_FAPU_ES: return meta->es0;

@@ -38,10 +38,10 @@ hashes=$(awk '$1 == "frame" { print $NF }' "$tmp/play.txt" | sort -u | wc -l)
 [ "$hashes" -gt 10 ] || fail "afm-play: the Song pose changes in only $hashes of the stream's frames"
 
 # Played together, the FAPs of a real stream move each lip FDP by its own
-# prescription, not by the sum of the FAPs that share its muscles
+# prescription, not by the sum of the FAPs that move it
 # (builder/fap/fap_partition.h): before the partition, Xface's joy moved
-# Song's lip FDPs 3.2 times as far as it asks (median), now 0.8 times. The
-# sanitizers' subset lacks most lip FAPs.
+# Song's lip FDPs 3.2 times as far as it asks (median), now 0.74-0.86 times.
+# The sanitizers' subset lacks most lip FAPs.
 if [ "${AFM_CONFIG:-release}" != sanitize ]; then
   "$bin/afm-play" "$tmp/song.afm" "$stream" --quiet --fdp-motion >"$tmp/motion.txt" 2>&1 ||
     fail "afm-play --fdp-motion failed on Song: $(tail -n 3 "$tmp/motion.txt")"

@@ -655,6 +655,17 @@ TEST(FapSynthesis, AFapThatIsTheSameSolveAsAnotherCopiesItsTarget) {
   EXPECT_EQ(both->outcomes[1].achieved, alone->outcomes[0].achieved);
 }
 
+// A target for the partition (fap_partition.h): FAP, FDP vertex, direction, muscles.
+SharingTarget sharing(int fap, int vertex, const Eigen::Vector3d &direction,
+                      std::vector<std::pair<std::string, int>> muscles) {
+  SharingTarget t;
+  t.fap = fap;
+  t.vertex = vertex;
+  t.direction = direction;
+  t.muscles = std::move(muscles);
+  return t;
+}
+
 // The partition itself (fap_partition.h), on points: targets linked through
 // shared muscles contracted the same way, a partition of unity over the
 // FAPs of a linked set, each FAP's weight 1 at its own FDP, equal shares
@@ -670,14 +681,16 @@ TEST(FapPartition, LinkedTargetsSplitThePointsAndEachFapCountsOnce) {
       6, -1, 2,  //
       20, 0, 0;
   const Eigen::Vector3d up = Eigen::Vector3d::UnitY(), right = -Eigen::Vector3d::UnitX();
-  std::vector<SharingTarget> t(6);
-  t[0] = {4, 0, up, {{"a", +1}}};              // FAP 4 at point 0
-  t[1] = {51, 1, up, {{"a", +1}, {"b", +1}}};  // linked to 4 by a, to 8 by b
-  t[2] = {8, 2, up, {{"b", +1}}};
-  t[3] = {4, 0, up, {{"a", -1}}};              // FAP 4's other side: a the other way
-  t[4] = {59, 0, up, {{"a", -1}}};             // the same point as FAP 4, linked to its other side
-  t[5] = {9, 5, up, {{"c", +1}}};              // alone
-  const FapPartition p = partition_shared_targets(X, t);
+  const Eigen::MatrixXi none;  // straight distances
+  std::vector<SharingTarget> t = {
+      sharing(4, 0, up, {{"a", +1}}),              // FAP 4 at point 0
+      sharing(51, 1, up, {{"a", +1}, {"b", +1}}),  // linked to 4 by a, to 8 by b
+      sharing(8, 2, up, {{"b", +1}}),
+      sharing(4, 0, up, {{"a", -1}}),   // FAP 4's other side: a the other way
+      sharing(59, 0, up, {{"a", -1}}),  // the same point as FAP 4, linked to its other side
+      sharing(9, 5, up, {{"c", +1}}),   // alone
+  };
+  const FapPartition p = partition_shared_targets(X, none, t);
   EXPECT_EQ(p.component[0], p.component[1]);
   EXPECT_EQ(p.component[1], p.component[2]);
   EXPECT_NE(p.component[0], p.component[3]) << "a contracted the other way is another motion";
@@ -700,10 +713,10 @@ TEST(FapPartition, LinkedTargetsSplitThePointsAndEachFapCountsOnce) {
   EXPECT_GT(p.weight[1](4) + p.weight[2](4), p.weight[0](4));
   // Both sides of one FAP in one set (linked through another FAP): each
   // side gets the FAP's whole share, as only one plays at a time.
-  std::vector<SharingTarget> u = {{64, 0, right, {{"l", +1}, {"r", -1}}},
-                                  {64, 0, right, {{"r", +1}, {"l", -1}}},
-                                  {61, 1, up, {{"l", +1}, {"r", +1}}}};
-  const FapPartition q = partition_shared_targets(X, u);
+  std::vector<SharingTarget> u = {sharing(64, 0, right, {{"l", +1}, {"r", -1}}),
+                                  sharing(64, 0, right, {{"r", +1}, {"l", -1}}),
+                                  sharing(61, 1, up, {{"l", +1}, {"r", +1}})};
+  const FapPartition q = partition_shared_targets(X, none, u);
   EXPECT_EQ(q.component[0], q.component[1]);
   for (Eigen::Index v = 0; v < X.rows(); ++v) {
     EXPECT_EQ(q.weight[0](v), q.weight[1](v));
@@ -711,10 +724,10 @@ TEST(FapPartition, LinkedTargetsSplitThePointsAndEachFapCountsOnce) {
   }
   // FAPs of one FDP with different directions (63 raises the nose tip, 64
   // bends it) each keep that point whole; a third FAP still shares with both.
-  std::vector<SharingTarget> nose = {{63, 0, up, {{"l", +1}, {"r", +1}}},
-                                     {64, 0, right, {{"l", +1}, {"r", -1}}},
-                                     {61, 2, up, {{"l", +1}}}};
-  const FapPartition r = partition_shared_targets(X, nose);
+  std::vector<SharingTarget> nose = {sharing(63, 0, up, {{"l", +1}, {"r", +1}}),
+                                     sharing(64, 0, right, {{"l", +1}, {"r", -1}}),
+                                     sharing(61, 2, up, {{"l", +1}})};
+  const FapPartition r = partition_shared_targets(X, none, nose);
   EXPECT_EQ(r.component[0], r.component[2]);
   EXPECT_NEAR(r.weight[0](0), 1, 1e-9);
   EXPECT_NEAR(r.weight[1](0), 1, 1e-9);
@@ -723,6 +736,48 @@ TEST(FapPartition, LinkedTargetsSplitThePointsAndEachFapCountsOnce) {
     EXPECT_NEAR(r.weight[0](v) + r.weight[2](v), 1, 1e-12) << v;
     EXPECT_NEAR(r.weight[1](v) + r.weight[2](v), 1, 1e-12) << v;
   }
+}
+
+// Targets of different muscles are linked when one moves the other's FDP
+// along the other's direction by over kFapOverlap of the other's own motion;
+// and the distances run along the mesh: two lips that touch at one point
+// (two vertices there, as on the reference head) are far apart.
+TEST(FapPartition, OverlappingTargetsLinkAndDistancesRunAlongTheMesh) {
+  // Two strips of three vertices, the upper one's left end on the lower
+  // one's left end (the mouth's corner is one vertex, its middle two).
+  Eigen::MatrixXd X(6, 3);
+  X << 0, 0, 0,  // 0: the corner
+      2, 0.1, 0,  // 1: upper middle
+      4, 1, 0,    // 2: upper far end
+      2, 0.1, 0,  // 3: lower middle, on the upper middle's point
+      4, -1, 0,   // 4: lower far end
+      2, 5, 0;    // 5: not in the mesh
+  Eigen::MatrixXi F(2, 3);
+  F << 0, 1, 2,  //
+      0, 4, 3;
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitY();
+  Eigen::MatrixXd upper = Eigen::MatrixXd::Zero(6, 3), lower = Eigen::MatrixXd::Zero(6, 3);
+  upper(1, 1) = -1, upper(3, 1) = 0.2;  // lowers the upper lip, lifts the lower by a fifth of its own
+  lower(3, 1) = 1;                      // raises the lower lip
+  std::vector<SharingTarget> t = {sharing(4, 1, -up, {{"u", +1}}), sharing(5, 3, up, {{"m", +1}})};
+  t[0].displacement = &upper, t[1].displacement = &lower;
+  FapPartition p = partition_shared_targets(X, F, t);
+  EXPECT_NE(p.component[0], p.component[1]) << "a fifth of the other's motion is below the overlap";
+  upper(3, 1) = 0.3;
+  p = partition_shared_targets(X, F, t);
+  ASSERT_EQ(p.component[0], p.component[1]);
+  // Along the mesh the middles are 4 apart (round the corner), not 0.
+  EXPECT_NEAR(p.weight[0](1), 1, 1e-9);
+  EXPECT_NEAR(p.weight[1](3), 1, 1e-9);
+  EXPECT_GT(p.weight[0](2), 0.5);
+  EXPECT_GT(p.weight[1](4), 0.5);
+  for (Eigen::Index v = 0; v < X.rows(); ++v) {
+    EXPECT_TRUE(std::isfinite(p.weight[0](v)) && std::isfinite(p.weight[1](v))) << v;
+    EXPECT_NEAR(p.weight[0](v) + p.weight[1](v), 1, 1e-12) << v;
+  }
+  // With straight distances the two middles would share their point.
+  const FapPartition straight = partition_shared_targets(X, Eigen::MatrixXi(), t);
+  EXPECT_EQ(straight.weight[0](1), 0.5);
 }
 
 // Real streams send the inner and outer lip FAPs together at equal values.

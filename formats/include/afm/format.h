@@ -186,7 +186,7 @@ typedef struct afm_meta {
 /* The X0 of a distance unit in model units (a FAP unit is X0 / 1024): the
  * meta's es0, irisd0, ens0, mns0 or mw0; 0 for AFM_FAPU_AU, AFM_FAPU_NONE
  * and a distance the file does not know. */
-double afm_meta_fapu_x0(const afm_meta *meta, afm_fapu unit);
+float afm_meta_fapu_x0(const afm_meta *meta, afm_fapu unit);
 
 typedef struct afm_part {
   const char *name;    /* unique in the file */
