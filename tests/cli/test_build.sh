@@ -6,6 +6,7 @@ test_name=test_build.sh
 . "$(dirname "$0")/lib/common.sh"
 gen="$bin/afm-headgen"
 info="$bin/afm-info"
+play="$bin/afm-play"
 bin="$bin/afm-build"
 
 "$bin" --help | grep -q -- "--muscle-map" || fail "--help does not list --muscle-map"
@@ -47,7 +48,7 @@ grep -qi "viseme  *10 " "$tmp/info.txt" || fail "afm-info lists no viseme 10: $(
 # A skin of 2,000 vertices is simulated on 1,000 of them (the default) and
 # its targets carried back to all of them.
 "$gen" --vertices 2000 -o "$tmp/h2.wrl" >/dev/null 2>&1 || fail "afm-headgen --vertices 2000 failed"
-"$bin" "$tmp/h2.wrl" "$tmp/h2.fdp" -q --faps 12 -o "$tmp/h2.afm" >"$tmp/h2.txt" 2>&1 ||
+"$bin" "$tmp/h2.wrl" "$tmp/h2.fdp" -q --faps 12,59 -o "$tmp/h2.afm" >"$tmp/h2.txt" 2>&1 ||
   fail "the 2k build failed: $(tail -n 5 "$tmp/h2.txt")"
 grep -q "^simulation mesh: 1000 of the skin's [0-9]* vertices" "$tmp/h2.txt" ||
   fail "no simulation mesh line: $(head -n 3 "$tmp/h2.txt")"
@@ -57,7 +58,32 @@ skin=$(sed -n "s/^simulation mesh: 1000 of the skin's \([0-9]*\) vertices.*/\1/p
 # (The AFM splits vertices at texture seams: at least the input's count.)
 stored=$(awk '$1 == "skin" && $2 == "skin" { print $3 }' "$tmp/h2info.txt")
 [ -n "$stored" ] && [ "$stored" -ge "$skin" ] || fail "the AFM's skin has ${stored:-no} vertices, not the input's $skin"
-grep -q "^targets: 2 made" "$tmp/h2.txt" || fail "FAP 12's two sides not made: $(tail -n 2 "$tmp/h2.txt")"
+grep -q "^targets: 4 made" "$tmp/h2.txt" || fail "FAPs 12 and 59, two sides each, not made: $(tail -n 2 "$tmp/h2.txt")"
+
+# FAPs 12 and 59 raise the inner and the outer lip corner, one vertex on this
+# head. Sent together at their reference (150), as real streams send them,
+# the corner rises by the prescription once (builder/fap/fap_partition.h);
+# before, each target moved it all the way and the two twice. Sent alone,
+# each raises it by half. afm-play --fdp-motion measures it against the
+# MPEG-4 rule.
+mask() { awk -v on="$1" 'BEGIN { n = split(on, f, ","); for (i = 1; i <= 68; ++i) { m = 0; for (j = 1; j <= n; ++j) if (f[j] == i) m = 1; printf "%s%d", (i > 1 ? " " : ""), m } print "" }'; }
+{ echo "2.1 corner 25 2"; mask 12,59; echo "0 150 150"; mask 12,59; echo "1 150 150"; } >"$tmp/both.fap"
+{ echo "2.1 corner 25 2"; mask 12; echo "0 150"; mask 12; echo "1 150"; } >"$tmp/alone.fap"
+reached() {  # FDP group $2 of afm-play --fdp-motion's table in file $1: the median share reached
+  awk -v g="$2" '$1 == g { for (i = 2; i <= NF; ++i) if ($i ~ /^[0-9]+$/) { print $(i + 1); exit } }' "$1"
+}
+for s in both alone; do
+  "$play" "$tmp/h2.afm" "$tmp/$s.fap" --quiet --fdp-motion >"$tmp/$s.txt" 2>&1 ||
+    fail "afm-play --fdp-motion failed: $(cat "$tmp/$s.txt")"
+done
+for g in 2 8; do
+  r=$(reached "$tmp/both.txt" "$g")
+  awk -v r="$r" 'BEGIN { exit !(r >= 95 && r <= 105) }' ||
+    fail "FAPs 12 + 59 at 150 move the corner (FDP group $g) by ${r:-no} % of the prescription, not 95..105 %: $(cat "$tmp/both.txt")"
+done
+r=$(reached "$tmp/alone.txt" 2)
+awk -v r="$r" 'BEGIN { exit !(r >= 45 && r <= 55) }' ||
+  fail "FAP 12 alone moves the corner by ${r:-no} % of its prescription, not half: $(cat "$tmp/alone.txt")"
 expect_error "bad simulation size" 2 "at least 200, or full" - -- "$bin" "$tmp/h2.wrl" "$tmp/h2.fdp" --sim-vertices 50
 
 # Placement only: the summary and three pictures.
