@@ -46,7 +46,10 @@ static void usage(FILE *out) {
           "played motion (the head's rotation left out) is compared with it: per FDP\n"
           "group, the median share of the prescription reached along it, the median\n"
           "distance from it relative to its length, and the 90th percentile share\n"
-          "(1 is exact; above 1, the face overshoots the stream).\n"
+          "(100 %% is exact; above it, the face overshoots the stream). Motion that no\n"
+          "FAP of an FDP prescribes counts as played: the jaw's opening (FAP 3 names\n"
+          "only the chin, 2.1) moves the lower lip's FDPs too.\n"
+          "\n"
           "Exit status: 0 on success, 1 on bad input (the message names the file and\n"
           "line or field), 2 on bad usage.\n");
 }
