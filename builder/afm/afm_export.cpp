@@ -372,6 +372,11 @@ Expected<std::vector<uint8_t>> encode_afm(const AfmContent &content, afm_profile
       if (D.rows() != scene.parts[p].V.rows() || D.cols() != 3)
         return Status::error("target " + std::to_string(mt.number) + ": displacement of part '" +
                              scene.parts[p].name + "' is not #V x 3");
+      // lround of a NaN is unspecified: a broken target must not become
+      // 16-bit garbage in the file.
+      if (!D.allFinite())
+        return Status::error("target " + std::to_string(mt.number) + ": displacement of part '" +
+                             scene.parts[p].name + "' is not finite");
       for (Eigen::Index w = 0; w < D.rows(); ++w) {
         std::array<int16_t, 6> q{};
         for (int k = 0; k < 3; ++k)
@@ -383,6 +388,8 @@ Expected<std::vector<uint8_t>> encode_afm(const AfmContent &content, afm_profile
         for (uint32_t r : rv.copies[p][static_cast<size_t>(w)]) moved.push_back({r, q});
       }
     }
+    if (!mt.controls.allFinite())
+      return Status::error("target " + std::to_string(mt.number) + ": a control's displacement is not finite");
     for (Eigen::Index c = 0; c < mt.controls.rows(); ++c) {
       std::array<int16_t, 6> q{};
       for (int k = 0; k < 3; ++k)

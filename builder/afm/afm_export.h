@@ -104,6 +104,8 @@ RenderVertices afm_render_vertices(const AfmContent &content);
 double afm_position_quantum(const Scene &scene);
 
 // Encodes the content; `profile` AFM_PROFILE_DRACO uses the Draco codec.
+// Fails, saying which target and part, on a displacement that is not
+// #V x 3 or not finite, and on a lift the format cannot hold.
 Expected<std::vector<uint8_t>> encode_afm(const AfmContent &content, afm_profile profile);
 
 // encode_afm, then an atomic write.

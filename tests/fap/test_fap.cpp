@@ -10,6 +10,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <limits>
 #include <memory>
 
 #include "afm/afm_export.h"
@@ -933,6 +934,12 @@ TEST(FapSynthesis, TargetsMadeOnACoarserSimulationMeshMatchTheSkins) {
   refused = encode_afm(bad, AFM_PROFILE_RAW);
   ASSERT_FALSE(refused.is_ok());
   EXPECT_NE(refused.status().message().find("no normal deltas"), std::string::npos) << refused.status().message();
+  // A non-finite motion is refused, not rounded into the file.
+  bad = content;
+  bad.targets[0].controls(0, 1) = std::numeric_limits<double>::quiet_NaN();
+  refused = encode_afm(bad, AFM_PROFILE_RAW);
+  ASSERT_FALSE(refused.is_ok());
+  EXPECT_NE(refused.status().message().find("not finite"), std::string::npos) << refused.status().message();
 }
 
 // Song on afm-build's simulation mesh, its eye sphincters calibrated.
