@@ -50,22 +50,23 @@ FapPartition partition_shared_targets(const Eigen::MatrixXd &X, const Eigen::Mat
   auto usable = [&targets, &X](size_t k) {
     return targets[k].vertex >= 0 && targets[k].vertex < X.rows() && !targets[k].muscles.empty();
   };
+  // Linked: the groups share a muscle contracted the same way, or one's
+  // target moves the other's FDP along the other's motion by more than
+  // kFapOverlap of the other's own target there.
+  auto overlaps = [&targets](size_t i, size_t j) {
+    const SharingTarget &ti = targets[i], &tj = targets[j];
+    if (!ti.displacement || !tj.displacement || ti.fap == tj.fap) return false;
+    const Eigen::Vector3d along = tj.side * tj.direction;
+    const double own = tj.displacement->row(tj.vertex).dot(along.transpose());
+    const double cross = ti.displacement->row(tj.vertex).dot(along.transpose());
+    return own > 0 && cross > kFapOverlap * own;
+  };
   for (size_t a = 0; a < n; ++a)
     for (size_t b = a + 1; b < n && usable(a); ++b) {
       if (!usable(b)) continue;
       bool shared = false;
       for (const auto &m : targets[a].muscles)
         shared |= std::find(targets[b].muscles.begin(), targets[b].muscles.end(), m) != targets[b].muscles.end();
-      // Or one's target moves the other's FDP along the other's motion by
-      // more than kFapOverlap of the other's own target there.
-      auto overlaps = [&targets](size_t i, size_t j) {
-        const SharingTarget &ti = targets[i], &tj = targets[j];
-        if (!ti.displacement || !tj.displacement || ti.fap == tj.fap) return false;
-        const Eigen::Vector3d along = tj.side * tj.direction;
-        const double own = tj.displacement->row(tj.vertex).dot(along.transpose());
-        const double cross = ti.displacement->row(tj.vertex).dot(along.transpose());
-        return own > 0 && cross > kFapOverlap * own;
-      };
       if (shared || overlaps(a, b) || overlaps(b, a)) parent[root(a)] = root(b);
     }
   FapPartition out;
