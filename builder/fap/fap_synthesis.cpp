@@ -626,7 +626,6 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
   // FAP targets that move the same skin split it (fap_partition.h).
   {
     std::vector<SharingTarget> sharing(work.size());
-    std::vector<Eigen::Vector3d> dirs(work.size(), Eigen::Vector3d::Zero());
     for (size_t k = 0; k < work.size(); ++k) {
       const FapMapping *f = work[k].fap;
       if (!f || f->driver != FapDriver::Muscles || f->lid || !results[k].target) continue;
@@ -637,8 +636,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       sharing[k].vertex = p->vertex;
       for (const FapContraction &c : work[k].side > 0 ? f->positive : f->negative)
         sharing[k].muscles.push_back({c.muscle, c.percent > 0 ? +1 : -1});
-      dirs[k] = fap_direction(info);
-      sharing[k].direction = dirs[k];
+      sharing[k].direction = fap_direction(info);
       sharing[k].side = work[k].side;
       sharing[k].displacement = &results[k].target->displacement[static_cast<size_t>(model.skin)];
     }
@@ -664,14 +662,15 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       std::string with;
       for (size_t j = 0; j < work.size(); ++j) {
         if (j == k || part.component[j] != part.component[k] || sharing[j].vertex != v ||
-            work[j].side != work[k].side || sharing[j].fap == sharing[k].fap || dirs[j] != dirs[k] ||
+            work[j].side != work[k].side || sharing[j].fap == sharing[k].fap ||
+            sharing[j].direction != sharing[k].direction ||
             part.weight[j].size() == 0)
           continue;
         achieved += static_cast<double>(work[k].fap->reference) / work[j].fap->reference *
                     results[j].target->displacement[sk].row(v).transpose();
         with += (with.empty() ? "" : ", ") + std::to_string(sharing[j].fap);
       }
-      measure(o, achieved, dirs[k]);
+      measure(o, achieved, sharing[k].direction);
       if (!with.empty())
         o.message += std::string(o.message.empty() ? "" : "; ") + "its FDP is FAP " + with +
                      "'s too: each moves it by a share, measured together at the same value";

@@ -161,7 +161,7 @@ static int write_obj(const char *dir, uint32_t index, const afm_doc *doc, const 
 typedef struct fdp_motion {
   uint32_t point[AFM_FAP_COUNT + 1]; /* per FAP 3..68: its FDP's index in meta.fdps, or AFM_NONE */
   double *share[12], *error[12];     /* per group: along share and relative distance */
-  uint32_t count[12], capacity;
+  uint32_t count[12], capacity[12]; /* per group: samples taken, room */
 } fdp_motion;
 
 /* Which FDP each distance FAP names (the first point of that id on a
@@ -178,10 +178,17 @@ static int fdp_motion_init(fdp_motion *fm, const afm_doc *doc, uint32_t frames) 
       if (p->group == info->fdp_group && p->index == info->fdp_index && p->vertex != AFM_NONE) fm->point[f] = i;
     }
   }
-  fm->capacity = frames * (doc->meta.fdp_count ? doc->meta.fdp_count : 1);
+  /* Room per group: every frame of each FDP of the group that a FAP names. */
+  for (i = 0; i < doc->meta.fdp_count; ++i) {
+    const uint8_t group = doc->meta.fdps[i].group;
+    int named = 0;
+    for (f = 3; f <= AFM_FAP_COUNT; ++f) named |= fm->point[f] == i;
+    if (named && group < 12) fm->capacity[group] += frames;
+  }
   for (g = 0; g < 12; ++g) {
-    fm->share[g] = (double *)malloc(fm->capacity * sizeof(double));
-    fm->error[g] = (double *)malloc(fm->capacity * sizeof(double));
+    if (!fm->capacity[g]) continue;
+    fm->share[g] = (double *)malloc(fm->capacity[g] * sizeof(double));
+    fm->error[g] = (double *)malloc(fm->capacity[g] * sizeof(double));
     if (!fm->share[g] || !fm->error[g]) return 0;
   }
   return 1;
@@ -214,7 +221,7 @@ static void fdp_motion_add(fdp_motion *fm, const afm_doc *doc, const afm_player 
       for (k = 0; k < 3; ++k) want[k] += v * unit * info->direction[k];
       named = 1;
     }
-    if (!named || pt->group > 11 || fm->count[pt->group] >= fm->capacity) continue;
+    if (!named || pt->group > 11 || fm->count[pt->group] >= fm->capacity[pt->group]) continue;
     for (k = 0; k < 3; ++k) len += want[k] * want[k];
     len = sqrt(len);
     if (!(len >= limit) || limit <= 0) continue;
