@@ -24,7 +24,7 @@ std::vector<FdpId> anatomy_fdps() {
     if (std::find(out.begin(), out.end(), id) == out.end()) out.push_back(id);
   };
   for (const MuscleDef &d : muscle_table())
-    for (const char *text : {d.attachment_or_major, d.insertion_or_minor, d.epicentre}) {
+    for (const char *text : {d.attachment_or_major, d.insertion_or_minor, d.epicentre, d.corner_outer, d.corner_inner}) {
       if (!text) continue;
       Expected<Keypoint> k = parse_keypoint(text);
       if (k)

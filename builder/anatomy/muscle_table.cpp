@@ -11,7 +11,8 @@ namespace {
 using K = MuscleKind;
 
 // name, kind, attachment | semi-major end, insertion | semi-minor end, epicentre,
-// width, sense, max, min, calibrate_minor, lips_or_cheeks, essential.
+// width, sense, max, min, calibrate_minor, lips_or_cheeks, essential[, the lid's
+// corners].
 // Decisions where the paper's tables slip (docs/anatomy.md):
 //  - frontalis_inner_right: the paper writes 11.3 (the left hairline) in its
 //    attachment; every other right frontalis uses 11.2, so 11.2 here.
@@ -47,6 +48,13 @@ const std::vector<MuscleDef> kTable = {
     {"orbicularis_oculi_left", K::Sphincter, "3.7", "3.9", "3.5", 1.8, +1, 0.50, 0.20, true, false, false},
     {"orbicularis_oculi_right", K::Sphincter, "3.12", "3.10", "3.6", 1.8, +1, 0.50, 0.20, true, false, false},
     {"orbicularis_oris", K::Sphincter, "8.3", "8.2", "1/2 (8.1 + 8.2)", 1.6, +1, 0.25, 0.10, false, true, true},
+    // The lids (not in the paper; docs/anatomy.md "The lids"). +100 % takes
+    // the upper margin nine tenths of the opening down the eyeball, -100 %
+    // (levator palpebrae) a quarter up; the lower lid half and a sixth.
+    {"palpebral_upper_left", K::Lid, "3.1", "3.3", nullptr, 0, +1, 0.90, 0.25, false, false, false, "3.7", "3.11"},
+    {"palpebral_upper_right", K::Lid, "3.2", "3.4", nullptr, 0, +1, 0.90, 0.25, false, false, false, "3.8", "3.12"},
+    {"palpebral_lower_left", K::Lid, "3.3", "3.1", nullptr, 0, +1, 0.50, 0.15, false, false, false, "3.7", "3.11"},
+    {"palpebral_lower_right", K::Lid, "3.4", "3.2", nullptr, 0, +1, 0.50, 0.15, false, false, false, "3.8", "3.12"},
 };
 
 struct Parser {
@@ -116,6 +124,15 @@ struct Parser {
 }  // namespace
 
 const std::vector<MuscleDef> &muscle_table() { return kTable; }
+
+const char *muscle_kind_name(MuscleKind kind) {
+  switch (kind) {
+    case MuscleKind::Linear: return "linear";
+    case MuscleKind::Sphincter: return "sphincter";
+    case MuscleKind::Lid: return "lid";
+  }
+  return "?";
+}
 
 int find_muscle(const std::string &name) {
   for (size_t i = 0; i < kTable.size(); ++i)

@@ -1,4 +1,6 @@
-// The 25 muscles of the method paper (Tables 1 and 2), as data.
+// The 25 muscles of the method paper (Tables 1 and 2), as data, and the
+// four lid drivers this project adds (the palpebral part of orbicularis
+// oculi, one per lid: docs/anatomy.md "The lids").
 //
 // Key points are written as in the paper, affine combinations of FDP
 // positions: "11.1 + 1/6 (11.3 - 11.1)". parse_keypoint() turns one into
@@ -16,7 +18,9 @@
 
 namespace afmb {
 
-enum class MuscleKind { Linear, Sphincter };
+// Lid: the palpebral part of orbicularis oculi in one lid, which turns the
+// lid about its eyeball's horizontal axis (muscles.h). Not in the paper.
+enum class MuscleKind { Linear, Sphincter, Lid };
 
 // One row of Table 1 or 2 plus the constants the paper leaves to the
 // implementer. Sides are the face's own (MPEG-4: left is +x).
@@ -26,6 +30,8 @@ struct MuscleDef {
   // Linear: attachment (skull) and insertion (dermis) key points.
   // Sphincter: a = end of the semi-major axis, b = end of the semi-minor
   // axis (both on the hypodermis) and the epicentre (a free point).
+  // Lid: a = the lid's margin (3.1 for the upper left lid), b = the other
+  // lid's margin; the eyeball under a gives the centre.
   const char *attachment_or_major;
   const char *insertion_or_minor;
   const char *epicentre;  // sphincters only, else nullptr
@@ -44,7 +50,8 @@ struct MuscleDef {
   // The displacement at +100 % and at -100 % contraction (section 3.3),
   // as fractions of the fibre length (linear: the insertion moves along the
   // fibre) or of the semi-axis (sphincter: the semi-axis key node moves
-  // toward the epicentre; which axis is `calibrate_minor`).
+  // toward the epicentre; which axis is `calibrate_minor`; lid: the margin
+  // moves along the eyeball toward the other lid, a fraction of the opening).
   double max_fraction, min_fraction;
   bool calibrate_minor;  // sphincters: calibrate on the minor axis node
   // Lips and cheeks (section 3.2.4): the nodes of the influence area are not
@@ -54,11 +61,18 @@ struct MuscleDef {
   // Without it the face cannot make its basic FAPs: a build without its FDPs
   // fails instead of skipping the muscle.
   bool essential;
+  // Lid: the eye's corners (outer, inner), where the margin is held: the
+  // load fades to nothing there. Others: nullptr.
+  const char *corner_outer = nullptr, *corner_inner = nullptr;
 };
 
 // The 25 muscles, in the paper's order (Table 1 top to bottom, left before
-// right, then Table 2).
+// right, then Table 2), then the four lid drivers (upper left, upper right,
+// lower left, lower right).
 const std::vector<MuscleDef> &muscle_table();
+// "linear", "sphincter", "lid".
+const char *muscle_kind_name(MuscleKind kind);
+constexpr int kPaperMuscles = 25;
 // Index in muscle_table() of a muscle name, or -1.
 int find_muscle(const std::string &name);
 

@@ -1,5 +1,7 @@
 #include "anatomy/muscles.h"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <deque>
@@ -39,6 +41,97 @@ double dead_load(const SkinModel &skin, const Muscle &m, double c, const Directi
   return energy;
 }
 
+// The lid's turn about its axis: the offset of p from the axis line and
+// its distance rho from it.
+struct AxisOffset {
+  Eigen::Vector3d d;  // p - c without its component along the axis
+  double rho;
+};
+AxisOffset axis_offset(const Muscle &m, const Eigen::Vector3d &p) {
+  Eigen::Vector3d d = p - m.epicentre;
+  d -= d.dot(m.axis) * m.axis;
+  return {d, d.norm()};
+}
+// The angle from a to b about the axis (positive: the sense of axis x a).
+double turn(const Muscle &m, const Eigen::Vector3d &a, const Eigen::Vector3d &b) {
+  return std::atan2(m.axis.dot(a.cross(b)), a.dot(b));
+}
+// Nodes nearer the axis than this share of the eyeball's radius get no lid
+// load: their pull would grow as 1 / rho.
+constexpr double kLidAxisFloor = 0.5;
+
+Status place_lid(const SkinModel &skin, const Eigen::Vector3d &outer, const Eigen::Vector3d &inner, Muscle &m) {
+  m.force_layer = kEpidermis;
+  m.node_a = nearest_node(skin, kEpidermis, m.key_a);
+  m.node_b = nearest_node(skin, kEpidermis, m.key_b);
+  const int va = skin.vertex_of(m.node_a);
+  const Eigen::Vector3d a = skin.X0.row(m.node_a), b = skin.X0.row(m.node_b);
+  // The eyeball the margin lies on: within half a radius of its surface (a
+  // lower margin faces up, away from it, and is not SkinModel::eye_of).
+  double nearest = 0.5;
+  for (size_t e = 0; e < skin.eyes.size(); ++e) {
+    const double off = std::abs((a - skin.eyes[e].centre).norm() / skin.eyes[e].radius - 1);
+    if (off < nearest) nearest = off, m.eye = static_cast<int>(e);
+  }
+  if (m.eye < 0)
+    return Status::error("muscle " + m.name + ": its lid margin does not lie on an eyeball (no eye part there)");
+  const EyeSphere &eye = skin.eyes[static_cast<size_t>(m.eye)];
+  m.epicentre = eye.centre;
+  m.length = (a - b).norm();
+  if (!(m.length > 0)) return Status::error("muscle " + m.name + ": the lid margins map to one point");
+  // Turning about +x takes the front of the eyeball down: the upper lid's way.
+  const double side = a.y() > b.y() ? 1.0 : -1.0;
+  m.axis = Eigen::Vector3d(side, 0, 0);
+  const double mid = 0.5 * (a.y() + b.y());
+  const AxisOffset oa = axis_offset(m, a);
+  // The lid: the skin reached from the margin on its side of the opening,
+  // within the eyeball's width and half a radius of its surface. That takes
+  // in the margin's underside and the skin turning into the socket behind
+  // it, which point away from the eyeball and are not SkinModel::eye_of.
+  auto in_lid = [&](int v) {
+    if (!skin.in_mesh[static_cast<size_t>(v)]) return false;
+    const Eigen::Vector3d p = skin.X0.row(skin.node(kEpidermis, v));
+    return (p.y() - mid) * side > 0 && std::abs(p.x() - eye.centre.x()) < eye.radius &&
+           (p - eye.centre).norm() < 1.5 * eye.radius;
+  };
+  std::vector<int> area;
+  if (in_lid(va)) {
+    std::vector<uint8_t> seen(static_cast<size_t>(skin.n), 0);
+    std::deque<int> queue{va};
+    seen[static_cast<size_t>(va)] = 1;
+    while (!queue.empty()) {
+      const int v = queue.front();
+      queue.pop_front();
+      area.push_back(v);
+      for (int u : skin.neighbours[static_cast<size_t>(v)])
+        if (!seen[static_cast<size_t>(u)] && in_lid(u)) {
+          seen[static_cast<size_t>(u)] = 1;
+          queue.push_back(u);
+        }
+    }
+    std::sort(area.begin(), area.end());
+  }
+  std::vector<double> alpha, across;
+  for (int v : area) {
+    const Eigen::Vector3d p = skin.X0.row(skin.node(kEpidermis, v));
+    alpha.push_back(-turn(m, oa.d, axis_offset(m, p).d));  // away from the opening
+    // 0 over the margin's key point, 1 at the corner on p's side.
+    const double corner = (p.x() - a.x()) * (outer.x() - a.x()) >= 0 ? outer.x() : inner.x();
+    across.push_back(corner != a.x() ? std::min(1.0, (p.x() - a.x()) / (corner - a.x())) : 1.0);
+  }
+  double alpha_max = 0;
+  for (double x : alpha) alpha_max = std::max(alpha_max, x);
+  for (size_t i = 0; i < area.size(); ++i) {
+    const double g = alpha[i] <= 0 ? 1.0 : std::pow(1 - alpha[i] / alpha_max, 4);
+    const double q = across[i];
+    const double w = skin.area[area[i]] * g * std::cos(kHalfPi * q * q);
+    if (!(w > 0)) continue;
+    m.influence.push_back(area[i]);
+    m.weight.push_back(w);
+  }
+  return Status::ok();
+}
+
 }  // namespace
 
 Expected<Muscle> place_muscle(const SkinModel &skin, const FdpSet &fdps, int def) {
@@ -51,7 +144,7 @@ Expected<Muscle> place_muscle(const SkinModel &skin, const FdpSet &fdps, int def
   m.width = d.width;
   std::vector<Keypoint> keys;
   std::vector<FdpId> absent;
-  for (const char *text : {d.attachment_or_major, d.insertion_or_minor, d.epicentre}) {
+  for (const char *text : {d.attachment_or_major, d.insertion_or_minor, d.epicentre, d.corner_outer, d.corner_inner}) {
     if (!text) continue;
     Expected<Keypoint> k = parse_keypoint(text);
     if (!k) return k.status();
@@ -86,6 +179,9 @@ Expected<Muscle> place_muscle(const SkinModel &skin, const FdpSet &fdps, int def
       m.influence.push_back(v);
       m.weight.push_back(w);
     }
+  } else if (d.kind == MuscleKind::Lid) {
+    if (keys.size() != 4) return Status::error(std::string("muscle ") + d.name + ": the table lacks its corners");
+    if (Status st = place_lid(skin, eval_keypoint(keys[2], fdps), eval_keypoint(keys[3], fdps), m); !st) return st;
   } else {
     m.force_layer = kHypodermis;
     m.epicentre = eval_keypoint(keys[2], fdps);
@@ -212,6 +308,34 @@ double muscle_load(const SkinModel &skin, const Muscle &m, double tension, const
     const Eigen::Vector3d a = skin.X0.row(m.node_a);
     energy = dead_load(skin, m, s, [&](const Eigen::Vector3d &x0) { return Eigen::Vector3d((a - x0).normalized()); },
                        X, F);
+  } else if (m.kind == MuscleKind::Lid) {
+    if (m.eye < 0 || static_cast<size_t>(m.eye) >= skin.eyes.size()) return 0.0;  // a model without its eyeball
+    const double radius = skin.eyes[static_cast<size_t>(m.eye)].radius, floor = kLidAxisFloor * radius;
+    for (size_t i = 0; i < m.influence.size(); ++i) {
+      for (int layer = kEpidermis; layer <= kHypodermis; ++layer) {
+        const int node = skin.node(layer, m.influence[i]);
+        const AxisOffset o0 = axis_offset(m, skin.X0.row(node));
+        if (o0.rho < floor) continue;
+        const AxisOffset o = axis_offset(m, X.row(node));
+        const double c = s * m.weight[i] / 3 * o0.rho * o0.rho / radius;  // potential -c theta
+        energy -= c * turn(m, o0.d, o.d);
+        const double rr = o.rho * o.rho;
+        if (F) F->row(node) += (c / rr) * m.axis.cross(o.d).transpose();
+        if (K) {
+          // The Hessian of -c theta is alpha R in (y, z), R = [2yz, z^2 - y^2;
+          // z^2 - y^2, -2yz] / rho^2 (a reflection) and alpha = -c axis.x / rho^2:
+          // indefinite, eigenvalues +-|alpha|. Its positive part goes into the
+          // tangent (with the whole of it the tangent was indefinite and CG
+          // stalled on the 2k head's lids; without any, Newton crawled).
+          const double y = o.d.y() / o.rho, z = o.d.z() / o.rho, alpha = -c * m.axis.x() / rr;
+          Eigen::Matrix2d R;
+          R << 2 * y * z, z * z - y * y, z * z - y * y, -2 * y * z;
+          Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
+          H.block<2, 2>(1, 1) = 0.5 * std::abs(alpha) * (Eigen::Matrix2d::Identity() + (alpha > 0 ? 1.0 : -1.0) * R);
+          K->emplace_back(node, H);
+        }
+      }
+    }
   } else if (s < 0) {
     // Widening: a dead load outward along the rest direction from the
     // epicentre. A push away from the moving epicentre direction would be
@@ -253,6 +377,11 @@ double muscle_action(const SkinModel &skin, const Muscle &m, const Eigen::Matrix
     if (gradient) gradient->row(m.node_b) += dir.transpose();
     return (b - b0).dot(dir);
   }
+  if (m.kind == MuscleKind::Lid) {
+    const AxisOffset o0 = axis_offset(m, skin.X0.row(m.node_a)), o = axis_offset(m, X.row(m.node_a));
+    if (gradient && o.rho > 0) gradient->row(m.node_a) += (o0.rho / (o.rho * o.rho)) * m.axis.cross(o.d).transpose();
+    return o0.rho * turn(m, o0.d, o.d);
+  }
   const bool minor = muscle_table()[static_cast<size_t>(m.def)].calibrate_minor;
   const int node = minor ? m.node_b : m.node_a;
   auto offset = [&](const Eigen::MatrixXd &P) {
@@ -265,7 +394,7 @@ double muscle_action(const SkinModel &skin, const Muscle &m, const Eigen::Matrix
 
 double muscle_action_target(const Muscle &m, bool maximum) {
   const MuscleDef &d = muscle_table()[static_cast<size_t>(m.def)];
-  const double scale = m.kind == MuscleKind::Linear ? m.length : (d.calibrate_minor ? m.semi_b : m.semi_a);
+  const double scale = m.kind != MuscleKind::Sphincter ? m.length : (d.calibrate_minor ? m.semi_b : m.semi_a);
   return maximum ? d.max_fraction * m.range_max * scale : -d.min_fraction * m.range_min * scale;
 }
 

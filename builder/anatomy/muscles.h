@@ -22,6 +22,26 @@
 //   w = area(p) g(rho),  g = 1 for rho <= 1, cos(pi/2 (rho - 1) / (k - 1)) beyond,
 // and the pull points at e in the x-y plane: -(d.x, d.y, 0) / max(|d.xy|, b / 3).
 //
+// Lid (the palpebral part of orbicularis oculi, not in the paper): turns the
+// lid about the horizontal axis through its eyeball's centre c (the sphere
+// SkinModel::eyes whose surface the margin key point a lies within half a
+// radius of), the axis along +-x so that a turns toward the other lid's
+// margin b. Its area is the skin reached from a's vertex on a's side of the
+// height halfway between the margins, within the eyeball's width and 1.5
+// radii of c. A vertex p at a turn alpha beyond a's (about the axis, growing
+// away from the opening; alpha_max the area's largest) weighs
+//   w = area(p) g(alpha) h(q),  g = 1 for alpha <= 0, (1 - alpha / alpha_max)^4 beyond,
+//                               h = cos(pi/2 q^2),
+// q = 0 over a and 1 at the eye's corner on p's side (and beyond): most at
+// the margin, nothing at the orbital rim and the corners. The load acts on
+// the vertex's epidermal, dermal and hypodermal nodes, a third each, except
+// nodes within half the eyeball's radius r of the axis. Its potential on a
+// node at rest distance rho0 from the axis is -t sense (w/3) (rho0^2 / r)
+// theta, theta the node's turn about the axis: a pull of t (w/3) rho0 / r
+// along the circle about the axis, so the nodes of the thin lid turn alike.
+// The action is the margin node's arc rho0 theta (its epidermal node);
+// +-100 % move it a fraction of the opening |a - b|.
+//
 // Force on a node: sense x t x w x direction, where t is the signed tension
 // (model force per unit area; positive: the muscle's action, negative: the
 // other way) and sense is the table's +1 / -1.
@@ -48,9 +68,9 @@ struct Muscle {
   Eigen::Vector3d key_a = Eigen::Vector3d::Zero();  // attachment, or semi-major end
   Eigen::Vector3d key_b = Eigen::Vector3d::Zero();  // insertion, or semi-minor end
   // Mapped nodes (global node indices into SkinModel::X0).
-  int node_a = -1;         // linear: skull node; sphincter: hypodermis node
-  int node_b = -1;         // linear: dermis node; sphincter: hypodermis node
-  double length = 0;       // linear: rest fibre length |node_b - node_a|
+  int node_a = -1;         // linear: skull node; sphincter: hypodermis node; lid: epidermal margin
+  int node_b = -1;         // linear: dermis node; sphincter: hypodermis node; lid: the other margin
+  double length = 0;       // linear: rest fibre length |node_b - node_a|; lid: the opening
   // Sphincter.
   Eigen::Vector3d epicentre = Eigen::Vector3d::Zero();
   double semi_a = 0, semi_b = 0;  // model units, along x and y, at the hypodermis key nodes
@@ -58,7 +78,11 @@ struct Muscle {
   double area_a = 0, area_b = 0;  // the ellipse through the key points on the skin's
                                   // surface: equation 1's axes, and what pictures draw
   double width = 0;        // omega, or the sphincter's ellipse scale k
-  int force_layer = kDermis;  // kDermis (linear) or kHypodermis (sphincter)
+  int force_layer = kDermis;  // kDermis (linear) or kHypodermis (sphincter); lid: 0..2
+  // Lid: the eyeball (index into SkinModel::eyes; its centre is `epicentre`)
+  // and the axis (+x or -x) the lid turns about as it closes.
+  int eye = -1;
+  Eigen::Vector3d axis = Eigen::Vector3d::Zero();
   std::vector<int> influence;   // skin vertices, sorted
   std::vector<double> weight;   // per influence vertex
   // Calibration (section 3.3): tension at +100 % and at -100 % contraction.
@@ -106,7 +130,7 @@ void remove_from_influence(Muscle &m, const std::vector<int> &vertices);
 // The muscle's load at signed tension t and positions X: returns its
 // potential energy; when F is given, adds its forces (4n x 3); when K is
 // given, appends its Hessian (a ForceField's, solver.h: the contracting
-// sphincter's only, the others are dead loads). The field
+// sphincter's and the positive part of a lid's, the others are dead loads). The field
 // is conservative: a linear muscle's pull is a dead load along the rest
 // direction u0 from the node to A, potential -t sense w (p - p0) . u0 (a
 // push away from a moving point would be unstable across the fibre); a
@@ -120,12 +144,14 @@ double muscle_load(const SkinModel &skin, const Muscle &m, double tension, const
 // How far the muscle has acted at positions X (model units, positive in the
 // direction of its action): linear, the insertion's motion along the fibre
 // toward the attachment times sense; sphincter, the calibrated semi-axis
-// node's motion toward the epicentre in the x-y plane. When `gradient` is
+// node's motion toward the epicentre in the x-y plane; lid, the margin
+// node's arc about the axis toward the other lid. When `gradient` is
 // given, adds the action's gradient with respect to X (4n x 3) to it.
 double muscle_action(const SkinModel &skin, const Muscle &m, const Eigen::MatrixXd &X,
                      Eigen::MatrixXd *gradient = nullptr);
 // The action at +100 % (positive) and at -100 % (negative) contraction: the
-// table's fraction of the fibre (or semi-axis) times range_max / range_min.
+// table's fraction of the fibre (semi-axis, lid opening) times range_max /
+// range_min.
 double muscle_action_target(const Muscle &m, bool maximum);
 
 }  // namespace afmb

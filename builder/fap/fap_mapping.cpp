@@ -58,13 +58,20 @@ std::vector<FapMapping> make_table() {
   add(18, D::Muscles, 300, {{"mentalis_left", 100}, {"mentalis_right", 100}},
       {{"mentalis_left", -100}, {"mentalis_right", -100}}, "mentalis lifts the chin's skin");
   // ---- group 3: eyelids, eyeballs, pupils ----
-  const char *upper = "the upper lid's half of orbicularis oculi's pose";
-  const char *lower = "the lower lid's half of orbicularis oculi's pose";
-  add(19, D::Muscles, 300, {{"orbicularis_oculi_left", 100}}, {{"orbicularis_oculi_left", -100}}, upper);
-  add(20, D::Muscles, 300, {{"orbicularis_oculi_right", 100}}, {{"orbicularis_oculi_right", -100}}, upper);
-  add(21, D::Muscles, 300, {{"orbicularis_oculi_left", 100}}, {{"orbicularis_oculi_left", -100}}, lower);
-  add(22, D::Muscles, 300, {{"orbicularis_oculi_right", 100}}, {{"orbicularis_oculi_right", -100}}, lower);
-  for (size_t k = t.size() - 4; k < t.size(); ++k) t[k].lid = t[k].fap <= 20 ? +1 : -1;
+  const char *upper = "the upper lid's driver turns it down over the eyeball (without an eye part: the upper "
+                      "lid's half of orbicularis oculi's pose)";
+  const char *lower = "the lower lid's driver turns it up over the eyeball (without an eye part: the lower "
+                      "lid's half of orbicularis oculi's pose)";
+  add(19, D::Muscles, 300, {{"palpebral_upper_left", 100}}, {{"palpebral_upper_left", -100}}, upper);
+  add(20, D::Muscles, 300, {{"palpebral_upper_right", 100}}, {{"palpebral_upper_right", -100}}, upper);
+  add(21, D::Muscles, 300, {{"palpebral_lower_left", 100}}, {{"palpebral_lower_left", -100}}, lower);
+  add(22, D::Muscles, 300, {{"palpebral_lower_right", 100}}, {{"palpebral_lower_right", -100}}, lower);
+  for (size_t k = t.size() - 4; k < t.size(); ++k) {
+    const std::string sphincter = t[k].fap % 2 ? "orbicularis_oculi_left" : "orbicularis_oculi_right";
+    t[k].lid = t[k].fap <= 20 ? +1 : -1;
+    t[k].fallback_positive = {{sphincter, 100}};
+    t[k].fallback_negative = {{sphincter, -100}};
+  }
   for (int f = 23; f <= 28; ++f) add(f, D::Rigid, 0, {}, {}, rigid_eye);
   add(29, D::None, 0, {}, {}, "pupil dilation needs pupil geometry, which the eye parts do not have");
   add(30, D::None, 0, {}, {}, "pupil dilation needs pupil geometry, which the eye parts do not have");

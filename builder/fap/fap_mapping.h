@@ -43,10 +43,15 @@ struct FapMapping {
   // the positive target is extrapolated (the report checks that side).
   std::vector<FapContraction> negative;
   const char *note = "";                    // why (None), or a remark
-  // Eyelid FAPs (19-22): one orbicularis oculi closes both lids, so the
-  // target keeps only its lid's half of the pose: +1 the upper lid, -1 the
-  // lower, split at the height halfway between the lid centres (3.1/3.3 or
-  // 3.2/3.4) and blended over the lids' opening. 0: the whole pose.
+  // The groups for a model that lacks a muscle of `positive` / `negative`
+  // (empty: none; the FAP is then not made).
+  std::vector<FapContraction> fallback_positive, fallback_negative;
+  // Eyelid FAPs (19-22) act through their lid's driver (the palpebral part
+  // of orbicularis oculi, muscle_table.h), which needs an eye part under the
+  // lid. Without one they fall back to orbicularis oculi, which closes both
+  // lids, and the target keeps only its lid's half of that pose: +1 the upper
+  // lid, -1 the lower, split at the height halfway between the lid centres
+  // (3.1/3.3 or 3.2/3.4) and blended over the lids' opening. 0: not a lid.
   int lid = 0;
 };
 

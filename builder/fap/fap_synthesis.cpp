@@ -129,6 +129,23 @@ std::string fap_label(int fap, int side) {
   return std::string(info ? info->name : "fap") + (side < 0 ? " (negative)" : "");
 }
 
+// The group a FAP's side acts through: its own, or its fallback when the
+// model lacks one of its own muscles and has every fallback muscle
+// (fap_mapping.h). *fallback tells which.
+const std::vector<FapContraction> &fap_group(const FaceModel &model, const FapMapping &map, int side,
+                                             bool *fallback = nullptr) {
+  const std::vector<FapContraction> &own = side > 0 ? map.positive : map.negative;
+  const std::vector<FapContraction> &alt = side > 0 ? map.fallback_positive : map.fallback_negative;
+  auto complete = [&model](const std::vector<FapContraction> &g) {
+    for (const FapContraction &c : g)
+      if (model.find(c.muscle) < 0) return false;
+    return true;
+  };
+  const bool use_alt = !complete(own) && !alt.empty() && complete(alt);
+  if (fallback) *fallback = use_alt;
+  return use_alt ? alt : own;
+}
+
 // Eyelid FAPs: weights the rows of D (#V x 3) by the lid's half (fap_mapping.h):
 // a smooth step in height across the lids' opening, 1 at the lid's centre.
 void keep_lid_half(const FaceModel &model, int fap, int lid, Eigen::MatrixXd &D) {
@@ -361,6 +378,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     const Eigen::Vector3d dir = fap_direction(info);
     const double unit = fapu_distance(model.fapu, info->unit) / 1024.0;
     const double value = map->reference * unit;  // along side x dir
+    bool fallback = false;  // the FAP acts through its fallback group
     o.prescribed = side * value * dir;
     const FdpPoint *fdp = model.fdps.find(FdpId{info->fdp_group, info->fdp_index}, model.skin);
     Pose pose;
@@ -442,7 +460,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     } else {
       std::vector<std::pair<int, double>> pattern;
       std::string missing;
-      for (const FapContraction &c : side > 0 ? map->positive : map->negative) {
+      for (const FapContraction &c : fap_group(model, *map, side, &fallback)) {
         const int i = model.find(c.muscle);
         if (i < 0) missing += (missing.empty() ? "" : ", ") + c.muscle;
         else pattern.push_back({i, c.percent});
@@ -560,7 +578,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     }
     if (ok) {
       Eigen::MatrixXd D = shrink * (pose_epidermis(model, pose) - skin.X0.topRows(skin.n));
-      if (map->lid) keep_lid_half(model, map->fap, map->lid, D);
+      if (map->lid && fallback) keep_lid_half(model, map->fap, map->lid, D);
       measure(o, D.row(fdp->vertex).transpose(), dir);
       o.dynamic = static_cast<int>(pose.dynamic.size());
       o.made = true;
@@ -588,7 +606,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     const FdpPoint *p = model.fdps.find(FdpId{info->fdp_group, info->fdp_index}, model.skin);
     if (!p || p->part != model.skin || p->vertex < 0) continue;  // not made: no copy
     std::vector<std::pair<std::string, double>> group;
-    for (const FapContraction &c : work[k].side > 0 ? f->positive : f->negative) group.push_back({c.muscle, c.percent});
+    for (const FapContraction &c : fap_group(model, *f, work[k].side)) group.push_back({c.muscle, c.percent});
     const Eigen::Vector3d along = work[k].side * fap_direction(info);
     keys[k] = SolveKey{group, p->vertex, along.x(), along.y(), along.z(),
                        f->reference * fapu_distance(model.fapu, info->unit), f->lid};
@@ -634,7 +652,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       if (!p || p->part != model.skin || p->vertex < 0) continue;
       sharing[k].fap = f->fap;
       sharing[k].vertex = p->vertex;
-      for (const FapContraction &c : work[k].side > 0 ? f->positive : f->negative)
+      for (const FapContraction &c : fap_group(model, *f, work[k].side))
         sharing[k].muscles.push_back({c.muscle, c.percent > 0 ? +1 : -1});
       sharing[k].direction = fap_direction(info);
       sharing[k].side = work[k].side;

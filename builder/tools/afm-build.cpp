@@ -85,7 +85,7 @@ void usage(FILE *out) {
       "                          index.html showing them together\n"
       "  --list-faps             how each FAP, viseme and expression is made: muscles,\n"
       "                          jaw, rigid or not at all\n"
-      "  --list-muscles          the 25 muscles and their key points\n"
+      "  --list-muscles          the 25 muscles, the 4 lid drivers, their key points\n"
       "  -q, --quiet             no progress on stderr (else one line rewritten in\n"
       "                          place, or a line per tenth of the work when stderr\n"
       "                          is not a terminal)\n"
@@ -264,8 +264,8 @@ int main(int argc, char **argv) {
     std::printf("%-26s %-9s %-36s %-26s %s\n", "muscle", "kind", "attachment / semi-major end",
                 "insertion / semi-minor end", "epicentre");
     for (const MuscleDef &d : muscle_table())
-      std::printf("%-26s %-9s %-36s %-26s %s\n", d.name, d.kind == MuscleKind::Linear ? "linear" : "sphincter",
-                  d.attachment_or_major, d.insertion_or_minor, d.epicentre ? d.epicentre : "-");
+      std::printf("%-26s %-9s %-36s %-26s %s\n", d.name, muscle_kind_name(d.kind),
+                  d.attachment_or_major, d.insertion_or_minor, d.epicentre ? d.epicentre : d.kind == MuscleKind::Lid ? "the eyeball's centre" : "-");
     if (mesh_path.empty() && !list_faps) return 0;
   }
   if (list_faps) {
@@ -332,7 +332,7 @@ int main(int argc, char **argv) {
   std::printf("%-26s %9s %8s %8s %11s %11s\n", "muscle", "length", "area", "V_d", "tension+", "tension-");
   for (const Muscle &m : model->muscles)
     std::printf("%-26s %9.4g %8zu %8zu %11.4g %11.4g\n", m.name.c_str(),
-                m.kind == MuscleKind::Linear ? m.length : m.semi_a, m.influence.size(), m.dynamic.size(),
+                m.kind != MuscleKind::Sphincter ? m.length : m.semi_a, m.influence.size(), m.dynamic.size(),
                 m.tension_max, m.tension_min);
   const Jaw &j = model->jaw;
   std::printf("jaw: %zu skin vertices (%zu ray hits, %d removed and %d added by the mouth-window search), "
