@@ -256,7 +256,7 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
     if (m.name.rfind("upper_lip", 0) == 0) remove_from_influence(m, lips->lower);
   }
   for (const Muscle &m : model.muscles)
-    if (table[static_cast<size_t>(m.def)].lips_or_cheeks || m.kind == MuscleKind::Lid)
+    if (table[static_cast<size_t>(m.def)].skull_free)
       for (int v : m.influence) model.tissue.skull_free[static_cast<size_t>(v)] = 1;
   progress(2, steps_fixed, "muscles placed");
 

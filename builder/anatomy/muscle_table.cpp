@@ -11,7 +11,7 @@ namespace {
 using K = MuscleKind;
 
 // name, kind, attachment | semi-major end, insertion | semi-minor end, epicentre,
-// width, sense, max, min, calibrate_minor, lips_or_cheeks, essential[, the lid's
+// width, sense, max, min, calibrate_minor, skull_free, essential[, the lid's
 // corners].
 // Decisions where the paper's tables slip (docs/anatomy.md):
 //  - frontalis_inner_right: the paper writes 11.3 (the left hairline) in its
@@ -51,10 +51,10 @@ const std::vector<MuscleDef> kTable = {
     // The lids (not in the paper; docs/anatomy.md "The lids"). +100 % takes
     // the upper margin nine tenths of the opening down the eyeball, -100 %
     // (levator palpebrae) a quarter up; the lower lid half and a sixth.
-    {"palpebral_upper_left", K::Lid, "3.1", "3.3", nullptr, 0, +1, 0.90, 0.25, false, false, false, "3.7", "3.11"},
-    {"palpebral_upper_right", K::Lid, "3.2", "3.4", nullptr, 0, +1, 0.90, 0.25, false, false, false, "3.8", "3.12"},
-    {"palpebral_lower_left", K::Lid, "3.3", "3.1", nullptr, 0, +1, 0.50, 0.15, false, false, false, "3.7", "3.11"},
-    {"palpebral_lower_right", K::Lid, "3.4", "3.2", nullptr, 0, +1, 0.50, 0.15, false, false, false, "3.8", "3.12"},
+    {"palpebral_upper_left", K::Lid, "3.1", "3.3", nullptr, 0, +1, 0.90, 0.25, false, true, false, "3.7", "3.11"},
+    {"palpebral_upper_right", K::Lid, "3.2", "3.4", nullptr, 0, +1, 0.90, 0.25, false, true, false, "3.8", "3.12"},
+    {"palpebral_lower_left", K::Lid, "3.3", "3.1", nullptr, 0, +1, 0.50, 0.15, false, true, false, "3.7", "3.11"},
+    {"palpebral_lower_right", K::Lid, "3.4", "3.2", nullptr, 0, +1, 0.50, 0.15, false, true, false, "3.8", "3.12"},
 };
 
 struct Parser {

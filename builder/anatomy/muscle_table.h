@@ -54,10 +54,10 @@ struct MuscleDef {
   // moves along the eyeball toward the other lid, a fraction of the opening).
   double max_fraction, min_fraction;
   bool calibrate_minor;  // sphincters: calibrate on the minor axis node
-  // Lips and cheeks (section 3.2.4): the nodes of the influence area are not
-  // tied to the skull (hypodermis-to-skull springs of zero stiffness, no
-  // skull rejection).
-  bool lips_or_cheeks;
+  // Lips and cheeks (section 3.2.4), and the lids: the nodes of the
+  // influence area are not tied to the skull (hypodermis-to-skull springs of
+  // zero stiffness, no skull rejection).
+  bool skull_free;
   // Without it the face cannot make its basic FAPs: a build without its FDPs
   // fails instead of skipping the muscle.
   bool essential;

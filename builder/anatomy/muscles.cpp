@@ -41,6 +41,30 @@ double dead_load(const SkinModel &skin, const Muscle &m, double c, const Directi
   return energy;
 }
 
+// Breadth-first search over the skin mesh from vertex `start` through the
+// vertices `inside` accepts. Returns the vertices reached, sorted (none when
+// `start` is not inside).
+template <class Inside>
+std::vector<int> grow_region(const SkinModel &skin, int start, const Inside &inside) {
+  std::vector<int> out;
+  if (start < 0 || start >= skin.n || !inside(start)) return out;
+  std::vector<uint8_t> seen(static_cast<size_t>(skin.n), 0);
+  std::deque<int> queue{start};
+  seen[static_cast<size_t>(start)] = 1;
+  while (!queue.empty()) {
+    const int v = queue.front();
+    queue.pop_front();
+    out.push_back(v);
+    for (int u : skin.neighbours[static_cast<size_t>(v)])
+      if (!seen[static_cast<size_t>(u)] && inside(u)) {
+        seen[static_cast<size_t>(u)] = 1;
+        queue.push_back(u);
+      }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 // The lid's turn about its axis: the offset of p from the axis line and
 // its distance rho from it.
 struct AxisOffset {
@@ -94,23 +118,7 @@ Status place_lid(const SkinModel &skin, const Eigen::Vector3d &outer, const Eige
     return (p.y() - mid) * side > 0 && std::abs(p.x() - eye.centre.x()) < eye.radius &&
            (p - eye.centre).norm() < 1.5 * eye.radius;
   };
-  std::vector<int> area;
-  if (in_lid(va)) {
-    std::vector<uint8_t> seen(static_cast<size_t>(skin.n), 0);
-    std::deque<int> queue{va};
-    seen[static_cast<size_t>(va)] = 1;
-    while (!queue.empty()) {
-      const int v = queue.front();
-      queue.pop_front();
-      area.push_back(v);
-      for (int u : skin.neighbours[static_cast<size_t>(v)])
-        if (!seen[static_cast<size_t>(u)] && in_lid(u)) {
-          seen[static_cast<size_t>(u)] = 1;
-          queue.push_back(u);
-        }
-    }
-    std::sort(area.begin(), area.end());
-  }
+  const std::vector<int> area = grow_region(skin, va, in_lid);
   std::vector<double> alpha, across;
   for (int v : area) {
     const Eigen::Vector3d p = skin.X0.row(skin.node(kEpidermis, v));
@@ -252,23 +260,7 @@ std::vector<int> mouth_window_search(const SkinModel &skin, const MouthWindow &w
     const Eigen::Vector3d p = skin.X0.row(v);
     return p.x() > w.left && p.x() < w.right && p.y() > w.bottom && p.y() < w.top;
   };
-  std::vector<int> out;
-  if (start < 0 || start >= skin.n || !inside(start)) return out;
-  std::vector<uint8_t> seen(static_cast<size_t>(skin.n), 0);
-  std::deque<int> queue{start};
-  seen[static_cast<size_t>(start)] = 1;
-  while (!queue.empty()) {
-    const int v = queue.front();
-    queue.pop_front();
-    out.push_back(v);
-    for (int u : skin.neighbours[static_cast<size_t>(v)])
-      if (!seen[static_cast<size_t>(u)] && inside(u)) {
-        seen[static_cast<size_t>(u)] = 1;
-        queue.push_back(u);
-      }
-  }
-  std::sort(out.begin(), out.end());
-  return out;
+  return grow_region(skin, start, inside);
 }
 
 Expected<MouthLips> mouth_lips(const SkinModel &skin, const FdpSet &fdps) {
