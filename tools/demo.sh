@@ -59,7 +59,7 @@ rm -rf "$out/frames"
 echo
 echo "demo outputs in $out/:"
 echo "  head.wrl head.fdp head.png      the generated head and a picture of it"
-echo "  muscles.png                     its 25 muscles and the jaw as placed from the FDPs"
+echo "  muscles.png                     its 25 muscles, lid drivers and jaw as placed from the FDPs"
 echo "  head.afm                        its anatomical AFM (draco)"
 echo "  report/index.html sheet.png     the fidelity report: every target, pictured"
 echo "  demo.fap                        the stream"

@@ -283,9 +283,10 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
       todo.push_back(i);
   const size_t tasks = todo.size() + (options.calibrate_jaw ? 1 : 0);
   std::vector<Status> result(tasks);
-  // Per muscle and side (-, +): 1 when a pose tore the skin in its
-  // calibration, 2 when it still does at the range kept.
-  std::vector<std::array<int, 2>> tore(model.muscles.size(), {0, 0});
+  // Per muscle and side (-, +), why its range was cut: 0 its tissue locks,
+  // 1 a pose tore the skin, 2 it still tears at the range kept, 3 the solver
+  // found no equilibrium there.
+  std::vector<std::array<int, 2>> cut(model.muscles.size(), {0, 0});
   Expected<Pose> jaw_pose = Status::error("jaw: not solved");
   model.jaw.dynamic = model.jaw.vertices;
   // The wave estimates first, then the calibrations, the largest estimated
@@ -314,24 +315,25 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
       Expected<std::vector<int>> &set = sets[k];
       Status s = set ? Status::ok() : set.status().wrap("calibrating " + m.name);
       // A muscle whose tissue locks before its key node reaches the
-      // table's range, or whose pose there tears the skin, calibrates to a
-      // half, a quarter or an eighth of it instead (not an essential one:
+      // table's range, whose pose there tears the skin, or where the solver
+      // finds no equilibrium (a coarse lid turned 50 degrees), calibrates to
+      // a half, a quarter or an eighth of it instead (not an essential one:
       // its range is what the FAPs rely on).
       const bool essential = table[static_cast<size_t>(m.def)].essential;
       auto side = [&](bool maximum) {
         bool locked = false, torn = false;
-        int &tears = tore[todo[k]][maximum ? 1 : 0];
+        int &why = cut[todo[k]][maximum ? 1 : 0];
         Status st = calibrate_side(model, m, maximum, &cache, *set, &locked, essential ? nullptr : &torn);
         double &range = maximum ? m.range_max : m.range_min;
-        while ((locked || torn) && range > 0.125 && !essential) {
-          tears = tears || torn;
+        while ((!st || torn) && range > 0.125 && !essential) {
+          if (why != 1) why = torn ? 1 : locked ? 0 : 3;
           range /= 2;
           locked = torn = false;
           st = calibrate_side(model, m, maximum, &cache, *set, &locked, &torn);
         }
         // Torn even at an eighth: kept there, so that the FAPs and
         // expressions have the muscle; their own checks bound its share.
-        if (torn) tears = 2;
+        if (torn) why = 2;
         return st;
       };
       if (s) s = side(false);
@@ -367,12 +369,14 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
       if (range == 1) continue;
       const std::string side = maximum ? "+100" : "-100";
       const char *part = range == 0.5 ? "a half" : range == 0.25 ? "a quarter" : "an eighth";
-      const int tears = tore[i][maximum ? 1 : 0];
-      model.warnings.push_back(m.name + ": " + (tears ? "the skin tears" : "its tissue locks") +
-                               " before the key node reaches the table's " + side + " % (" +
+      const int why = cut[i][maximum ? 1 : 0];
+      const char *cause = why == 0   ? ": its tissue locks before the key node reaches"
+                          : why == 3 ? ": the solver finds no equilibrium with the key node at"
+                                     : ": the skin tears before the key node reaches";
+      model.warnings.push_back(m.name + cause + " the table's " + side + " % (" +
                                std::to_string(std::abs(muscle_action_target(m, maximum)) / range) +
                                " model units): " + side + " % stands for " + part + " of it" +
-                               (tears == 2 ? ", where it still tears the skin" : ""));
+                               (why == 2 ? ", where it still tears the skin" : ""));
     }
     kept.push_back(std::move(model.muscles[i]));
   }
