@@ -84,6 +84,19 @@ std::string target_name(const afm_target &t) {
 std::vector<std::string> target_names(const afm_doc &doc) {
   std::vector<std::string> names;
   for (uint32_t i = 0; i < doc.target_count; ++i) names.push_back(target_name(doc.targets[i]));
+  // In-betweens: every target of a FAP side but the one nearest zero.
+  for (uint32_t i = 0; i < doc.target_count; ++i) {
+    const afm_target &t = doc.targets[i];
+    if (t.kind != AFM_TARGET_FAP) continue;
+    for (uint32_t j = 0; j < doc.target_count; ++j) {
+      const afm_target &u = doc.targets[j];
+      if (j != i && u.kind == t.kind && u.number == t.number && (u.reference > 0) == (t.reference > 0) &&
+          std::abs(u.reference) < std::abs(t.reference)) {
+        names[i] += "_" + std::to_string(std::abs(t.reference));
+        break;
+      }
+    }
+  }
   return names;
 }
 

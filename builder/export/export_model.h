@@ -45,11 +45,13 @@ double fap_frame_seconds(const FapStream &stream, size_t i);
 // The name exporters give a morph target: the MPEG-4 FAP name ("open_jaw"),
 // with "_neg" for a FAP's negative-side target (reference < 0);
 // "viseme_<name>" ("viseme_p_b_m") and "expression_<name>"
-// ("expression_joy"). Unique within a valid AFM. Names are letters, digits
-// and '_', starting with a letter: legal in VRML, OBJ and file names.
+// ("expression_joy"). Names are letters, digits and '_', starting with a
+// letter: legal in VRML, OBJ and file names.
 std::string target_name(const afm_target &target);
 
-// Every target's name, in doc.targets order.
+// Every target's name, in doc.targets order: target_name(), and for an
+// in-between (a FAP side's target past the one nearest zero) its |reference|
+// appended ("close_t_l_eyelid_1024"). Unique within a valid AFM.
 std::vector<std::string> target_names(const afm_doc &doc);
 
 // The target's position deltas on one part of doc: #part.vertex_count x 3,

@@ -60,12 +60,14 @@ afm_result afm_targets_decode_at(const uint8_t *raw, size_t size, uint64_t file_
     if (t.reference == 0 || (t.kind != AFM_TARGET_FAP && t.reference < 0))
       return afm_fail(&r, AFM_ERR_RANGE, "target %lu (%s %u): reference value %ld",
                       (unsigned long)i, kind_text(t.kind), (unsigned)t.number, (long)t.reference);
+    /* A FAP side may have several targets (in-betweens, version 1.2), each
+     * at its own reference; a viseme or an expression has one. */
     for (j = 0; targets && j < i; ++j)
       if (targets[j].kind == t.kind && targets[j].number == t.number &&
-          (targets[j].reference > 0) == (t.reference > 0))
-        return afm_fail(&r, AFM_ERR_RANGE, "target %lu: %s %u (%s side) appears twice",
+          (t.kind != AFM_TARGET_FAP || targets[j].reference == t.reference))
+        return afm_fail(&r, AFM_ERR_RANGE, "target %lu: %s %u (reference %ld) appears twice",
                         (unsigned long)i, kind_text(t.kind), (unsigned)t.number,
-                        t.reference > 0 ? "positive" : "negative");
+                        (long)t.reference);
     if (t.run_count > afm_remaining(&r) / 8 || t.delta_count > afm_remaining(&r) / 6)
       return afm_fail(&r, AFM_ERR_TRUNCATED, "target %lu: %lu runs and %lu deltas cannot fit",
                       (unsigned long)i, (unsigned long)t.run_count,

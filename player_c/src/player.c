@@ -31,6 +31,7 @@ static size_t layout(afm_player *p, uint8_t *base, const afm_doc *doc, uint32_t 
     at += ((uint64_t)(count) * sizeof(type) + 7u) & ~(uint64_t)7u;   \
   } while (0)
   TAKE(max_delta, int32_t, N);
+  TAKE(next_target, int32_t, N);
   TAKE(weight_scratch, int32_t, 2 * N);
   TAKE(weights, afm_q12, N);
   TAKE(acc, int32_t, 3 * E);

@@ -1,5 +1,22 @@
-/* FAP state -> morph target weights, weight = value / reference (Q12). */
+/* FAP state -> morph target weights (Q12). A FAP side with one target:
+ * weight = value / reference. With in-betweens (targets at references
+ * r1 < r2 < ... on one side, formats/afm.md): piecewise linear, the value
+ * blends the two targets around it, and beyond the farthest the last
+ * segment extrapolates. */
 #include "player_internal.h"
+
+/* In 64 bits: -INT32_MIN does not fit 32. */
+static int64_t magnitude(int32_t reference) { return reference < 0 ? -(int64_t)reference : reference; }
+
+/* Inserts target `index` into the chain starting at *head, ordered by
+ * |reference| (the parser rejects equal references on one side). */
+static void add_to_chain(afm_player *p, int32_t *head, int32_t index) {
+  const afm_target *targets = p->doc->targets;
+  const int64_t r = magnitude(targets[index].reference);
+  while (*head >= 0 && magnitude(targets[*head].reference) < r) head = &p->next_target[*head];
+  p->next_target[index] = *head;
+  *head = index;
+}
 
 static void add_lookup(int32_t *table, int32_t index) {
   if (*table < 0) *table = index; /* the first target of a kind wins */
@@ -14,9 +31,10 @@ void afm_weights_init(afm_player *p) {
   for (i = 0; i < doc->target_count; ++i) {
     const afm_target *t = &doc->targets[i];
     int32_t m = 0;
+    p->next_target[i] = -1;
     if (t->kind == AFM_TARGET_FAP && t->number <= AFM_FAP_COUNT)
-      add_lookup(t->reference > 0 ? &p->fap_positive[t->number] : &p->fap_negative[t->number],
-                 (int32_t)i);
+      add_to_chain(p, t->reference > 0 ? &p->fap_positive[t->number] : &p->fap_negative[t->number],
+                   (int32_t)i);
     else if (t->kind == AFM_TARGET_VISEME && t->number < AFM_VISEME_COUNT)
       add_lookup(&p->viseme[t->number], (int32_t)i);
     else if (t->kind == AFM_TARGET_EXPRESSION && t->number < AFM_EXPRESSION_COUNT)
@@ -44,7 +62,7 @@ int32_t afm_lerp_value(int32_t a, int32_t b, afm_q16 t) {
  * target's weight. |numerator| < 2^32 and 4096 = 2^12: the product is below
  * 2^44. Each term is clamped to 2^24 (a weight of 4096, far past the Q12
  * range the kernel saturates to), so a sum of a few stays in 32 bits. */
-static void add_weight(int32_t *w, int32_t target, int64_t numerator, int32_t reference) {
+static void add_weight(int32_t *w, int32_t target, int64_t numerator, int64_t reference) {
   int64_t num, den, q;
   if (target < 0 || numerator == 0 || reference == 0) return;
   num = numerator * AFM_Q12_ONE;
@@ -63,10 +81,26 @@ static void state_weights(const afm_player *p, const afm_fap_state *s, int32_t *
   for (f = 3; f <= AFM_FAP_COUNT; ++f) {
     int32_t v = s->value[f], t;
     if (v == 0) continue;
-    /* A negative value takes the FAP's negative-side target when there is
-     * one, else extrapolates the positive one. */
+    /* A negative value takes the FAP's negative-side targets when there
+     * are some, else extrapolates the positive side's first segment. */
     t = v < 0 && p->fap_negative[f] >= 0 ? p->fap_negative[f] : p->fap_positive[f];
-    if (t >= 0) add_weight(w, t, v, doc->targets[t].reference);
+    if (t < 0) continue;
+    {
+      /* The segment around v: from the previous reference (0 and no
+       * target at first) to the first reference at or past v, or the last
+       * segment beyond the farthest. References and values are int32, so
+       * the differences fit 33 bits and add_weight's bounds hold. */
+      int32_t prev = -1;
+      int64_t r0 = 0, r1 = doc->targets[t].reference;
+      const int64_t along = r1 > 0 ? v : -(int64_t)v; /* v along the side's sense */
+      while (p->next_target[t] >= 0 && along > (r1 > 0 ? r1 : -r1)) {
+        prev = t, r0 = r1;
+        t = p->next_target[t];
+        r1 = doc->targets[t].reference;
+      }
+      add_weight(w, t, v - r0, r1 - r0);
+      if (prev >= 0) add_weight(w, prev, r1 - v, r1 - r0);
+    }
   }
   if (s->viseme.select1 < AFM_VISEME_COUNT)
     add_weight(w, p->viseme[s->viseme.select1], s->viseme.blend, 63);

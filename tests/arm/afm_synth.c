@@ -14,7 +14,8 @@
  *   - every translating FAP 3..68 whose FDP sits on the skin: reference 256,
  *     the bump moved 0.1 FAPU-distance along the FAP's direction; normal
  *     deltas on even FAPs; a negative-side target (reference -256, another
- *     shape) on every third bidirectional FAP;
+ *     shape) on every third bidirectional FAP; an in-between at 640 (the
+ *     bump further along and turned) on every fourth FAP;
  *   - visemes 1..14 and expressions 1..6 (reference 63): mixes of bumps around
  *     the lips, mouth corners and eyebrows.
  * --lift: the targets move control points instead (formats/afm.md, LIFT):
@@ -35,7 +36,7 @@
 #include "afm/format.h"
 #include "afm/mpeg4.h"
 
-#define MAX_TARGETS 128
+#define MAX_TARGETS 192
 
 typedef struct synth {
   const afm_doc *in;
@@ -187,6 +188,17 @@ static void fap_targets(synth *s) {
       clear(s);
       bump(s, c, 0.3 * s->es0_q, 3, d, n);
       emit(s, AFM_TARGET_FAP, f, -256, f % 2 == 1);
+    }
+    if (f % 4 == 0) {
+      /* An in-between past the first (version 1.2): the bump further
+       * along and turned, as a lid over an eyeball turns. */
+      for (k = 0; k < 3; ++k) {
+        d[k] = 2.5 * amp * info->direction[k] + 0.6 * amp * info->direction[(k + 2) % 3];
+        n[k] = -1500.0 * info->direction[(k + 1) % 3];
+      }
+      clear(s);
+      bump(s, c, 0.4 * s->es0_q, 2, d, n);
+      emit(s, AFM_TARGET_FAP, f, 640, f % 8 == 0);
     }
   }
 }

@@ -82,7 +82,8 @@ if ! "$bin/afm-headgen" -o "$tmp/head.obj" --fdp "$tmp/head.fdp" >/dev/null ||
 fi
 
 # A synthetic stream: FAPs 1 and 2, every low-level FAP with changing masks
-# (unsent values persist), decimals with halves, values beyond range, eyeball,
+# (unsent values persist) up to 800 (past the synthetic in-betweens at 640),
+# decimals with halves, values beyond range, eyeball,
 # jaw and head rotations, comment lines.
 awk 'BEGIN {
   n = 60
@@ -96,8 +97,8 @@ awk 'BEGIN {
       if (!on) continue
       if (f == 1) { vals = vals " " (i % 15) " " ((i * 7) % 15) " " ((i * 5) % 64) " " (i % 2); continue }
       if (f == 2) { vals = vals " " (i % 7) " " ((i * 9) % 64) " " ((i * 3) % 7) " " ((i * 11) % 64) " 0 1"; continue }
-      v = ((i * 37 + f * 101) % 401) - 200
-      if ((f >= 23 && f <= 26) || (f >= 48 && f <= 50)) v = v * 60
+      v = ((i * 37 + f * 101) % 1601) - 800
+      if ((f >= 23 && f <= 26) || (f >= 48 && f <= 50)) v = v * 15
       if (f == 3 && i == 5) v = 99999
       if ((i + f) % 7 == 0) v = v ".5"
       else if ((i + f) % 11 == 0) v = v ".25"

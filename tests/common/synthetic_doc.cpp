@@ -206,6 +206,13 @@ const afm_doc *make_synthetic_doc(SyntheticDoc &s, const SyntheticOptions &o) {
   add_target(s, AFM_TARGET_FAP, 31, -256, false, smile_field, entries);  // negative side of FAP 31
   add_target(s, AFM_TARGET_VISEME, 1, 63, false, jaw_field, entries);
   add_target(s, AFM_TARGET_EXPRESSION, 1, 63, false, smile_field, entries);
+  if (o.in_betweens) {
+    // Farther targets on FAP 12's positive side and FAP 31's negative one,
+    // out of order on purpose (the player sorts them by |reference|).
+    add_target(s, AFM_TARGET_FAP, 12, 1800, false, brow_field, entries);
+    add_target(s, AFM_TARGET_FAP, 12, 1024, normal_deltas, jaw_field, entries);
+    add_target(s, AFM_TARGET_FAP, 31, -700, false, jaw_field, entries);
+  }
   for (size_t i = 0; i < s.targets.size(); ++i) {
     SyntheticDoc::Target &t = s.target_data[i];
     afm_target &at = s.targets[i];

@@ -49,6 +49,9 @@ struct SyntheticOptions {
   // the targets move the controls (the eye keeps vertex deltas). No normal
   // deltas then.
   bool lift = false;
+  // In-between targets (formats/afm.md, version 1.2): FAP 12 also at 1024
+  // and 1800, FAP 31 also at -700, each with a field of its own.
+  bool in_betweens = false;
 };
 
 // Fills `s` and returns &s.doc (valid while `s` lives and is not moved).

@@ -25,6 +25,7 @@
 #include "export/obj_export.h"
 #include "export/vrml_export.h"
 #include "io/vrml.h"
+#include "../common/synthetic_doc.h"
 #include "../common/test_paths.h"
 
 namespace {
@@ -87,6 +88,26 @@ TEST(ExportNames, FollowTheMpeg4Tables) {
   t.kind = AFM_TARGET_EXPRESSION, t.number = 1;
   EXPECT_EQ(afmb::target_name(t), "expression_joy");
   const std::vector<std::string> names = afmb::target_names(reference_doc());
+  EXPECT_EQ(std::set<std::string>(names.begin(), names.end()).size(), names.size()) << "names not unique";
+}
+
+// In-betweens (formats/export.md): a FAP side's target nearest zero keeps the
+// plain name, the farther ones add their |reference|, in any file order.
+TEST(ExportNames, InBetweensAddTheirReference) {
+  afmtest::SyntheticDoc s;
+  afmtest::SyntheticOptions o;
+  o.in_betweens = true;
+  const afm_doc &doc = *afmtest::make_synthetic_doc(s, o);
+  const std::vector<std::string> names = afmb::target_names(doc);
+  std::map<int32_t, std::string> fap12, fap31;
+  for (uint32_t i = 0; i < doc.target_count; ++i) {
+    if (doc.targets[i].kind != AFM_TARGET_FAP) continue;
+    if (doc.targets[i].number == 12) fap12[doc.targets[i].reference] = names[i];
+    if (doc.targets[i].number == 31) fap31[doc.targets[i].reference] = names[i];
+  }
+  const std::string smile = afm_fap(12)->name, brow = afm_fap(31)->name;
+  EXPECT_EQ(fap12, (std::map<int32_t, std::string>{{512, smile}, {1024, smile + "_1024"}, {1800, smile + "_1800"}}));
+  EXPECT_EQ(fap31, (std::map<int32_t, std::string>{{256, brow}, {-256, brow + "_neg"}, {-700, brow + "_neg_700"}}));
   EXPECT_EQ(std::set<std::string>(names.begin(), names.end()).size(), names.size()) << "names not unique";
 }
 

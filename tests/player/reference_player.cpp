@@ -1,6 +1,7 @@
 #include "reference_player.h"
 
 #include <cmath>
+#include <iterator>
 #include <map>
 #include <tuple>
 
@@ -9,7 +10,8 @@ namespace afmtest {
 namespace {
 
 struct Lookup {
-  std::map<std::pair<int, int>, int> fap;  // (FAP, positive?) -> target
+  // (FAP, positive side?) -> (|reference|, target), nearest zero first.
+  std::map<std::pair<int, bool>, std::map<double, int>> fap;
   std::map<int, int> viseme, expression;
 };
 
@@ -17,21 +19,36 @@ Lookup make_lookup(const afm_doc &doc) {
   Lookup l;
   for (uint32_t i = 0; i < doc.target_count; ++i) {
     const afm_target &t = doc.targets[i];
-    if (t.kind == AFM_TARGET_FAP) l.fap.insert({{t.number, t.reference > 0}, int(i)});
+    if (t.kind == AFM_TARGET_FAP) l.fap[{t.number, t.reference > 0}][std::fabs(double(t.reference))] = int(i);
     if (t.kind == AFM_TARGET_VISEME) l.viseme.insert({t.number, int(i)});
     if (t.kind == AFM_TARGET_EXPRESSION) l.expression.insert({t.number, int(i)});
   }
   return l;
 }
 
+// formats/afm.md: the face is piecewise linear in the value between a
+// side's references (0 at 0), the last segment extrapolated; a negative
+// value without targets of its own extrapolates the positive side's first.
 std::vector<double> weights_of(const afm_doc &doc, const Lookup &l, const afm_fap_state &s) {
   std::vector<double> w(doc.target_count, 0.0);
   for (int f = 3; f <= AFM_FAP_COUNT; ++f) {
-    int32_t v = s.value[f];
-    if (!v) continue;
-    auto it = v < 0 ? l.fap.find({f, false}) : l.fap.end();
-    if (it == l.fap.end()) it = l.fap.find({f, true});
-    if (it != l.fap.end()) w[size_t(it->second)] += double(v) / doc.targets[it->second].reference;
+    const double v = s.value[f];
+    if (v == 0) continue;
+    auto side = v < 0 ? l.fap.find({f, false}) : l.fap.end();
+    if (side == l.fap.end()) side = l.fap.find({f, true});
+    if (side == l.fap.end()) continue;
+    const std::map<double, int> &chain = side->second;
+    const double sense = side->first.second ? 1.0 : -1.0, x = sense * v;  // x: along the side
+    double x0 = 0;
+    int t0 = -1;
+    auto it = chain.begin();
+    while (std::next(it) != chain.end() && x > it->first) {
+      x0 = it->first, t0 = it->second;
+      ++it;
+    }
+    const double u = (x - x0) / (it->first - x0);
+    w[size_t(it->second)] += u;
+    if (t0 >= 0) w[size_t(t0)] += 1 - u;
   }
   auto add = [&](const std::map<int, int> &m, int number, double amount) {
     auto it = m.find(number);

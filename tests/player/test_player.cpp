@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -158,6 +159,14 @@ uint64_t fnv1a(uint64_t h, const void *data, size_t n) {
 }
 
 // Hash of a pose, serialised little-endian so the value is the same on any host.
+// The largest |position delta| component of a target, in quanta.
+int32_t largest_delta(const afm_target &tg) {
+  int32_t md = 0;
+  for (uint32_t k = 0; k < tg.delta_count; ++k)
+    md = std::max({md, std::abs(int32_t(tg.dx[k])), std::abs(int32_t(tg.dy[k])), std::abs(int32_t(tg.dz[k]))});
+  return md;
+}
+
 uint64_t pose_hash(const afm_player *p, uint32_t vertices) {
   uint64_t h = 1469598103934665603ull;
   const int32_t *x = afm_player_positions(p);
@@ -195,10 +204,7 @@ TEST(Player, FixedPointMatchesTheDoubleModelWithinTheStatedBound) {
     double morph_budget = 0.5;
     for (uint32_t i = 0; i < m.doc->target_count; ++i) {
       if (ref.weights[i] == 0) continue;
-      int32_t md = 0;
-      const afm_target &tg = m.doc->targets[i];
-      for (uint32_t k = 0; k < tg.delta_count; ++k)
-        md = std::max({md, std::abs(int32_t(tg.dx[k])), std::abs(int32_t(tg.dy[k])), std::abs(int32_t(tg.dz[k]))});
+      const int32_t md = largest_delta(m.doc->targets[i]);
       morph_budget += md / 8192.0;
     }
     // Largest distance from any vertex to any pivot, for the rigid term.
@@ -477,18 +483,19 @@ TEST(Player, PosingAllocatesNothing) {
 
 namespace {
 
-// The synthetic document with control points, read back from its raw file,
-// and a player on it.
-struct LiftedModel {
+// The synthetic document, with control points unless asked otherwise, read
+// back from its raw file, and a player on it.
+struct SyntheticModel {
   afmtest::SyntheticDoc source;
   std::unique_ptr<afm_doc, DocFree> doc;
   std::vector<uint64_t> memory;
   afm_player *player = nullptr;
 
-  LiftedModel() {
+  explicit SyntheticModel(bool lift = true, bool in_betweens = false) {
     afmtest::SyntheticOptions o;
     o.rows = 40, o.cols = 50;
-    o.lift = true;
+    o.lift = lift;
+    o.in_betweens = in_betweens;
     const std::vector<uint8_t> bytes = afmtest::write_doc(*afmtest::make_synthetic_doc(source, o), AFM_PROFILE_RAW);
     afm_doc *d = nullptr;
     EXPECT_EQ(afm_doc_read_alloc(bytes.data(), bytes.size(), nullptr, nullptr, &d), AFM_OK);
@@ -520,6 +527,18 @@ afm_fap_state lifted_state(std::mt19937 &rng) {
   return s;
 }
 
+// Poses four states in turn (each interpolated from the one before at t) and
+// compares each pose's hash with its golden value.
+void expect_golden_frames(SyntheticModel &m, const afm_fap_state (&states)[4], afm_q16 t,
+                          const std::array<uint64_t, 4> &golden) {
+  for (int i = 0; i < 4; ++i) {
+    ASSERT_EQ(afm_player_pose(m.player, &states[i], i ? &states[i - 1] : nullptr, t), AFM_OK);
+    const uint64_t hash = pose_hash(m.player, m.doc->geometry.vertex_count);
+    std::printf("frame %d hash %016llx\n", i, static_cast<unsigned long long>(hash));
+    EXPECT_EQ(hash, golden[size_t(i)]) << "frame " << i;
+  }
+}
+
 }  // namespace
 
 // Error budget of a bound vertex, in quanta: the weight terms as for any
@@ -527,7 +546,7 @@ afm_fap_state lifted_state(std::mt19937 &rng) {
 // rounding of the lift to Q12 (2^-13) and the output rounding (0.5). The
 // double model lifts the controls exactly.
 TEST(Player, LiftedVerticesMatchTheDoubleModel) {
-  LiftedModel m;
+  SyntheticModel m;
   ASSERT_NE(m.doc->lift, nullptr);
   const afm_geometry &g = m.doc->geometry;
   std::mt19937 rng(99);
@@ -540,10 +559,7 @@ TEST(Player, LiftedVerticesMatchTheDoubleModel) {
     double budget = 0.5 + 1.0 / 8192;
     for (uint32_t i = 0; i < m.doc->target_count; ++i) {
       if (ref.weights[i] == 0) continue;
-      const afm_target &tg = m.doc->targets[i];
-      int32_t md = 0;
-      for (uint32_t k = 0; k < tg.delta_count; ++k)
-        md = std::max({md, std::abs(int32_t(tg.dx[k])), std::abs(int32_t(tg.dy[k])), std::abs(int32_t(tg.dz[k]))});
+      const int32_t md = largest_delta(m.doc->targets[i]);
       budget += md / 8192.0;
     }
     // The skin (all bound) only: the eye also turns, which the rigid test covers.
@@ -569,7 +585,7 @@ TEST(Player, LiftedVerticesMatchTheDoubleModel) {
 // The player restores only what a pose changed (controls included): any
 // sequence of poses ends where one pose from a fresh player does.
 TEST(Player, LiftedPoseSequenceEqualsAFreshPose) {
-  LiftedModel seq, fresh_model;
+  SyntheticModel seq, fresh_model;
   std::mt19937 rng(5);
   afm_fap_state neutral;
   afm_fap_state_reset(&neutral);
@@ -595,17 +611,103 @@ TEST(Player, LiftedPoseSequenceEqualsAFreshPose) {
 // arithmetic pinned (int64 products, one rounding to Q12). Update with a
 // reason, as GoldenPerFrameHash.
 TEST(Player, LiftedGoldenPerFrameHash) {
-  LiftedModel m;
+  SyntheticModel m;
   const afm_fap_state states[4] = {state({}), state({{3, 512}, {12, 300}}),
                                    state({{3, 1500}, {31, -200}, {23, 40000}, {48, -15000}}),
                                    state({{12, -900}, {31, 400}, {25, 25000}, {27, 300}})};
-  uint64_t hashes[4];
-  for (int i = 0; i < 4; ++i) {
-    ASSERT_EQ(afm_player_pose(m.player, &states[i], i ? &states[i - 1] : nullptr, 20000), AFM_OK);
-    hashes[i] = pose_hash(m.player, m.doc->geometry.vertex_count);
-    std::printf("frame %d hash %016llx\n", i, static_cast<unsigned long long>(hashes[i]));
+  expect_golden_frames(m, states, 20000,
+                       {0xdfd3734a4d72cc70ull, 0x03c0cf172fab673aull, 0x4c146d0f8a0b8223ull, 0xa19f9cbee7731fb6ull});
+}
+
+// ---- in-between targets ------------------------------------------------------------------------
+
+namespace {
+
+// The Q12 weight of the FAP target at `reference`.
+int weight_at(const SyntheticModel &m, int fap, int32_t reference) {
+  for (uint32_t i = 0; i < m.doc->target_count; ++i)
+    if (m.doc->targets[i].kind == AFM_TARGET_FAP && m.doc->targets[i].number == fap &&
+        m.doc->targets[i].reference == reference)
+      return afm_player_weights(m.player)[i];
+  ADD_FAILURE() << "no target of FAP " << fap << " at " << reference;
+  return 0;
+}
+
+}  // namespace
+
+// formats/afm.md: between a side's references the face is linear in the
+// value, each reference shows its target alone, and past the farthest the
+// last segment goes on. Exact Q12 values: every quotient here is exact or
+// rounds as stated.
+TEST(Player, InBetweenTargetsBlendPiecewiseLinearly) {
+  SyntheticModel m(false, true);
+  struct Case {
+    int32_t v12, v31;
+    int w512, w1024, w1800, w31p, w31n, w31n700;
+  };
+  const Case cases[] = {
+      {256, 128, 2048, 0, 0, 2048, 0, 0},          // first segment: value / reference
+      {512, -256, 4096, 0, 0, 0, 4096, 0},         // at the first references
+      {768, -478, 2048, 2048, 0, 0, 2048, 2048},   // halfway between 512 and 1024, -256 and -700
+      {1024, -700, 0, 4096, 0, 0, 0, 4096},        // at the second references: alone
+      {1412, -1144, 0, 2048, 2048, 0, -4096, 8192},  // halfway to 1800; -1144: past -700 by its segment
+      {2576, 0, 0, -4096, 8192, 0, 0, 0},          // past the farthest by its segment
+      {-256, 0, -2048, 0, 0, 0, 0, 0},             // no negative side: the first segment extrapolated
+  };
+  for (const Case &c : cases) {
+    const afm_fap_state s = state({{12, c.v12}, {31, c.v31}});
+    ASSERT_EQ(afm_player_pose(m.player, &s, nullptr, 0), AFM_OK);
+    EXPECT_EQ(weight_at(m, 12, 512), c.w512) << c.v12;
+    EXPECT_EQ(weight_at(m, 12, 1024), c.w1024) << c.v12;
+    EXPECT_EQ(weight_at(m, 12, 1800), c.w1800) << c.v12;
+    EXPECT_EQ(weight_at(m, 31, 256), c.w31p) << c.v31;
+    EXPECT_EQ(weight_at(m, 31, -256), c.w31n) << c.v31;
+    EXPECT_EQ(weight_at(m, 31, -700), c.w31n700) << c.v31;
   }
-  const uint64_t golden[4] = {0xdfd3734a4d72cc70ull, 0x03c0cf172fab673aull, 0x4c146d0f8a0b8223ull,
-                              0xa19f9cbee7731fb6ull};
-  for (int i = 0; i < 4; ++i) EXPECT_EQ(hashes[i], golden[i]) << "frame " << i;
+}
+
+// The fixed-point blend of in-betweens against the double model, over
+// values spanning every segment and past the farthest reference. Budget per
+// target in use: one Q12 unit of weight times its largest delta; plus the
+// output's rounding.
+TEST(Player, InBetweenTargetsMatchTheDoubleModel) {
+  SyntheticModel m(false, true);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  double worst = 0;
+  for (int trial = 0; trial < 30; ++trial) {
+    afm_fap_state a = state({}), b = state({});
+    for (afm_fap_state *s : {&a, &b}) {
+      s->value[12] = int32_t(std::lround(u(rng) * 2400));
+      s->value[31] = int32_t(std::lround(u(rng) * 1000));
+      s->value[3] = int32_t(std::lround(u(rng) * 1024));
+    }
+    const afm_q16 t = afm_q16(rng() % 65537);
+    ASSERT_EQ(afm_player_pose(m.player, &a, &b, t), AFM_OK);
+    const afmtest::ReferencePose ref = afmtest::reference_pose(*m.doc, a, b, t / 65536.0);
+    double budget = 0.5;
+    for (uint32_t i = 0; i < m.doc->target_count; ++i) {
+      if (ref.weights[i] == 0) continue;
+      const int32_t md = largest_delta(m.doc->targets[i]);
+      budget += md / 4096.0;  // half a Q12 unit from the weight's rounding, half from the lerp's
+    }
+    const uint32_t skin = m.doc->geometry.parts[0].vertex_count;
+    for (uint32_t v = 0; v < skin; ++v)
+      for (int k = 0; k < 3; ++k) {
+        const double e = std::fabs(afm_player_positions(m.player)[3 * size_t(v) + size_t(k)] - ref.positions[v][size_t(k)]);
+        ASSERT_LE(e, budget) << "trial " << trial << " vertex " << v << " axis " << k;
+        worst = std::max(worst, e);
+      }
+  }
+  std::printf("in-between targets, fixed vs double over 30 random poses: worst error %.3f quanta\n", worst);
+}
+
+// Golden per-frame hashes with in-betweens: the segment choice and its
+// weights pinned. Update with a reason, as GoldenPerFrameHash.
+TEST(Player, InBetweenGoldenPerFrameHash) {
+  SyntheticModel m(false, true);
+  const afm_fap_state states[4] = {state({{12, 700}}), state({{12, 1500}, {31, -500}}),
+                                   state({{12, 3000}, {31, -1200}, {3, 400}}), state({{12, -300}, {31, 300}})};
+  expect_golden_frames(m, states, 30000,
+                       {0x5b18097c2add03a2ull, 0x7dfeb00c08335741ull, 0x7938bfe3781c57ebull, 0xb9b0726dd6640126ull});
 }

@@ -88,7 +88,7 @@ void afm_free(const afm_allocator *allocator, void *ptr);
 
 #define AFM_MAGIC_SIZE 8          /* 0x89 'A' 'F' 'M' '\r' '\n' 0x1A '\n' */
 #define AFM_VERSION_MAJOR 1
-#define AFM_VERSION_MINOR 1 /* 1.1 added LIFT */
+#define AFM_VERSION_MINOR 2 /* 1.1 added LIFT, 1.2 in-between targets */
 
 #define AFM_FOURCC(a, b, c, d)                                        \
   ((uint32_t)(uint8_t)(a) | ((uint32_t)(uint8_t)(b) << 8) |           \

@@ -13,7 +13,9 @@
  *   - A FAP not sent in a frame keeps its last value (0 until first sent).
  *   - Low-level FAP f with value v moves its morph target by weight
  *     v / reference; a negative v uses the FAP's negative-side target when the
- *     AFM has one, else extrapolates the positive one.
+ *     AFM has one, else extrapolates the positive one. A side with in-betweens
+ *     (several targets, formats/afm.md) blends the two around v piecewise
+ *     linearly, the last segment extrapolated past the farthest.
  *   - FAP 1: viseme_select1 at blend/63 plus viseme_select2 at (63 - blend)/63.
  *   - FAP 2: expression_select1 at intensity1/63 plus expression_select2 at
  *     intensity2/63. init_face and the def flags are decoded and kept; they do
