@@ -93,7 +93,7 @@ static void state_weights(const afm_player *p, const afm_fap_state *s, int32_t *
       int32_t prev = -1;
       int64_t r0 = 0, r1 = doc->targets[t].reference;
       const int64_t along = r1 > 0 ? v : -(int64_t)v; /* v along the side's sense */
-      while (p->next_target[t] >= 0 && along > (r1 > 0 ? r1 : -r1)) {
+      while (p->next_target[t] >= 0 && along > magnitude(doc->targets[t].reference)) {
         prev = t, r0 = r1;
         t = p->next_target[t];
         r1 = doc->targets[t].reference;
