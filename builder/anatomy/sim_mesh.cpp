@@ -24,6 +24,7 @@
 #include <utility>
 
 #include "anatomy/fdp_completion.h"
+#include "anatomy/skin_model.h"
 #include "core/part_kind.h"
 
 namespace afmb {
@@ -49,6 +50,11 @@ constexpr double kFeatureReach = 0.3;
 // 1,500 vertices it reached 2.53 and 2.58 of its 3.06 units with the sizing
 // alone, 0.22 with a mouth sizing of 0.3, and calibrated only from 0.15.
 constexpr double kLipKeep = 0.2;
+// The lids keep every skin vertex within this many eyeball radii outside
+// its sphere. Song: 212 vertices (its simulation mesh then stops at 1,147
+// vertices instead of 1,000); the generated heads' lids lie farther out
+// (0.107 radii) and keep none.
+constexpr double kLidKeep = 0.1;
 // What a collapse may not do: turn a coarse triangle's normal further than
 // this from the skin normals it covers, or leave a skin vertex farther than
 // kMaxDistance eye separations from the coarse surface.
@@ -96,6 +102,21 @@ void keep_lips(MeshT &mesh, const Part &skin, const std::vector<Eigen::Vector3d>
   std::sort(near.begin(), near.end());
   near.resize(std::min(near.size(), static_cast<size_t>(std::max(budget, 0))));
   for (const auto &[d, v] : near) mesh.status(typename MeshT::VertexHandle(v)).set_locked(true);
+}
+
+// Locks the skin vertices within kLidKeep radii outside an eyeball's sphere
+// (near_eyeballs): the lids. The solver holds each simulated node there off
+// the eye (SkinModel::eye_near); a lid vertex carried from coarse corners
+// instead sank into it as the lid turned over the ball (Song's upper lid
+// margin 0.3 units in at FAP 19 = 600, with only the coarse nodes held).
+template <class MeshT>
+void keep_lids(MeshT &mesh, const Part &skin, const std::vector<EyeSphere> &eyes) {
+  std::vector<uint8_t> used(static_cast<size_t>(skin.V.rows()), 0);
+  for (Eigen::Index f = 0; f < skin.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) used[static_cast<size_t>(skin.F(f, k))] = 1;
+  const std::vector<int8_t> lid = near_eyeballs(skin.V, used, eyes, kLidKeep);
+  for (size_t v = 0; v < lid.size(); ++v)
+    if (lid[v] >= 0) mesh.status(typename MeshT::VertexHandle(static_cast<int>(v))).set_locked(true);
 }
 
 // For every skin vertex, the skin vertex at its mirror image in the plane
@@ -340,6 +361,7 @@ Expected<SimMesh> make_sim_mesh(const Scene &scene, const FdpSet &fdps, const Si
   for (int v = 0; v < n; ++v)
     if (locked[static_cast<size_t>(v)]) mesh.status(vh[static_cast<size_t>(v)]).set_locked(true);
   keep_lips(mesh, skin, lips, kLipKeep * es0, options.vertices / 2);
+  keep_lids(mesh, skin, fit_eyeballs(scene));
 
   using Decimater = OpenMesh::Decimater::DecimaterT<TriMesh>;
   Decimater dec(mesh);

@@ -20,12 +20,15 @@
 // half as long around the eyes and the mouth (the lids and lips need the
 // resolution). The lips keep every skin vertex within 0.2 eye separations
 // of a lip FDP (at most half the budget, nearest first): a decimated mouth
-// locks the sphincter of a detailed one (Song's). No collapse may turn a
-// triangle's normal by more than 60 degrees from the skin normals it
-// covers, leave a skin vertex more than 0.03 eye separations from the
-// coarse surface, or leave a triangle of aspect ratio above 5, and the mesh
-// stays a manifold with the same boundaries (the mouth slit and eye
-// openings). A mirror-symmetric skin (nine in ten vertices with a mirror
+// locks the sphincter of a detailed one (Song's). The lids keep every skin
+// vertex within a tenth of an eyeball's radius outside its sphere
+// (skin_model.h: fit_eyeballs, near_eyeballs), so the solver holds each of
+// them off the eye; the mesh may then stop above the vertex count asked
+// for. No collapse may turn a triangle's normal by more than 60 degrees
+// from the skin normals it covers, leave a skin vertex more than 0.03 eye
+// separations from the coarse surface, or leave a triangle of aspect ratio
+// above 5, and the mesh stays a manifold with the same boundaries (the
+// mouth slit and eye openings). A mirror-symmetric skin (nine in ten vertices with a mirror
 // image) keeps mirror images: FDP vertices lock their images, the sizing is
 // symmetric and ties break the same way on both sides (docs/anatomy.md).
 //

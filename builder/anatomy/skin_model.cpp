@@ -76,6 +76,62 @@ std::optional<EyeSphere> fit_sphere(const Eigen::MatrixXd &P) {
 
 }  // namespace
 
+std::vector<EyeSphere> fit_eyeballs(const Scene &scene) {
+  std::vector<EyeSphere> eyes;
+  for (PartKind kind : {PartKind::EyeLeft, PartKind::EyeRight}) {
+    const int e = scene.find_kind(kind);
+    if (e < 0) continue;
+    std::optional<EyeSphere> ball = fit_sphere(scene.parts[static_cast<size_t>(e)].V);
+    if (!ball) continue;
+    ball->part = e;
+    eyes.push_back(*ball);
+  }
+  return eyes;
+}
+
+std::vector<int8_t> over_eyeballs(const Eigen::MatrixXd &V, const Eigen::MatrixXd &N, const std::vector<uint8_t> &used,
+                                  const std::vector<EyeSphere> &eyes) {
+  std::vector<int8_t> out(static_cast<size_t>(V.rows()), -1);
+  for (size_t eye = 0; eye < eyes.size(); ++eye) {
+    const EyeSphere &ball = eyes[eye];
+    for (Eigen::Index v = 0; v < V.rows(); ++v) {
+      if (!used[static_cast<size_t>(v)] || out[static_cast<size_t>(v)] >= 0) continue;
+      const Eigen::Vector3d q = V.row(v).transpose() - ball.centre;
+      const double d = q.norm(), along = q.dot(N.row(v).transpose());
+      // Inward along -normal, the line comes nearest the centre `along` in.
+      if (d < ball.radius || d > 1.5 * ball.radius || along <= 0) continue;
+      if (q.squaredNorm() - along * along < ball.radius * ball.radius) out[static_cast<size_t>(v)] = static_cast<int8_t>(eye);
+    }
+  }
+  return out;
+}
+
+std::vector<int8_t> near_eyeballs(const Eigen::MatrixXd &V, const std::vector<uint8_t> &used,
+                                  const std::vector<EyeSphere> &eyes, double band) {
+  std::vector<int8_t> out(static_cast<size_t>(V.rows()), -1);
+  for (size_t eye = 0; eye < eyes.size(); ++eye)
+    for (Eigen::Index v = 0; v < V.rows(); ++v) {
+      if (!used[static_cast<size_t>(v)] || out[static_cast<size_t>(v)] >= 0) continue;
+      const double d = (V.row(v).transpose() - eyes[eye].centre).norm();
+      if (d >= eyes[eye].radius && d <= (1 + band) * eyes[eye].radius) out[static_cast<size_t>(v)] = static_cast<int8_t>(eye);
+    }
+  return out;
+}
+
+Eigen::MatrixXd vertex_normals(const Eigen::MatrixXd &V, const Eigen::MatrixXi &F) {
+  Eigen::MatrixXd N = Eigen::MatrixXd::Zero(V.rows(), 3);
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), d = V.row(F(f, 2));
+    const Eigen::Vector3d nrm = (b - a).cross(d - a);  // twice the area
+    for (int k = 0; k < 3; ++k) N.row(F(f, k)) += nrm.transpose();
+  }
+  for (Eigen::Index v = 0; v < V.rows(); ++v) {
+    const double len = N.row(v).norm();
+    if (len > 0) N.row(v) /= len;
+  }
+  return N;
+}
+
 Expected<SkinModel> build_skin_model(const Scene &scene, int part, const TissueParams &params) {
   if (part < 0 || part >= static_cast<int>(scene.parts.size()))
     return Status::error("skin model: no skin part");
@@ -95,7 +151,7 @@ Expected<SkinModel> build_skin_model(const Scene &scene, int part, const TissueP
 
   // Centre of gravity of the surface, areas and normals.
   m.area = Eigen::VectorXd::Zero(n);
-  m.normal = Eigen::MatrixXd::Zero(n, 3);
+  m.normal = vertex_normals(p.V, m.F);
   m.in_mesh.assign(static_cast<size_t>(n), 0);
   m.vertex_faces.assign(static_cast<size_t>(n), {});
   Eigen::Vector3d c = Eigen::Vector3d::Zero();
@@ -109,17 +165,12 @@ Expected<SkinModel> build_skin_model(const Scene &scene, int part, const TissueP
     for (int k = 0; k < 3; ++k) {
       const int v = m.F(f, k);
       m.area[v] += ar / 3.0;
-      m.normal.row(v) += nrm.transpose();
       m.in_mesh[static_cast<size_t>(v)] = 1;
       m.vertex_faces[static_cast<size_t>(v)].push_back(f);
     }
   }
   c /= total;
   m.centre = c;
-  for (int v = 0; v < n; ++v) {
-    const double len = m.normal.row(v).norm();
-    if (len > 0) m.normal.row(v) /= len;
-  }
   // The centre must be inside: most of the surface must face away from it.
   double outward = 0;
   for (int f = 0; f < m.F.rows(); ++f) {
@@ -219,27 +270,21 @@ Expected<SkinModel> build_skin_model(const Scene &scene, int part, const TissueP
   }
   m.skull_free.assign(static_cast<size_t>(n), 0);
 
-  m.eye_of.assign(static_cast<size_t>(n), -1);
-  for (PartKind kind : {PartKind::EyeLeft, PartKind::EyeRight}) {
-    const int e = scene.find_kind(kind);
-    if (e < 0) continue;
-    std::optional<EyeSphere> ball = fit_sphere(scene.parts[static_cast<size_t>(e)].V);
-    if (!ball) continue;
-    ball->part = e;
-    const auto eye = static_cast<int8_t>(m.eyes.size());
-    m.eyes.push_back(*ball);
-    for (int v = 0; v < n; ++v) {
-      if (!m.in_mesh[static_cast<size_t>(v)] || m.eye_of[static_cast<size_t>(v)] >= 0) continue;
-      const Eigen::Vector3d q = m.X0.row(v).transpose() - ball->centre;
-      const double d = q.norm(), along = q.dot(m.normal.row(v).transpose());
-      // Inward along -normal, the line comes nearest the centre `along` in.
-      if (d < ball->radius || d > 1.5 * ball->radius || along <= 0) continue;
-      if (q.squaredNorm() - along * along < ball->radius * ball->radius) {
-        m.eye_of[static_cast<size_t>(v)] = eye;
-        m.skull_free[static_cast<size_t>(v)] = 1;
-      }
+  m.eyes = fit_eyeballs(scene);
+  m.eye_of = over_eyeballs(p.V, m.normal, m.in_mesh, m.eyes);
+  m.eye_near = near_eyeballs(p.V, m.in_mesh, m.eyes);
+  m.eye_clearance.assign(static_cast<size_t>(n), 0.0);
+  for (int v = 0; v < n; ++v) {
+    const int8_t over = m.eye_of[static_cast<size_t>(v)];
+    if (over >= 0) m.eye_near[static_cast<size_t>(v)] = over;
+    if (const int8_t e = m.eye_near[static_cast<size_t>(v)]; e >= 0) {
+      const EyeSphere &ball = m.eyes[static_cast<size_t>(e)];
+      const double rest = (p.V.row(v).transpose() - ball.centre).norm() - ball.radius;
+      m.eye_clearance[static_cast<size_t>(v)] = std::clamp(rest, 0.0, kEyeClearance * ball.radius);
     }
   }
+  for (int v = 0; v < n; ++v)
+    if (m.eye_of[static_cast<size_t>(v)] >= 0) m.skull_free[static_cast<size_t>(v)] = 1;
   return m;
 }
 

@@ -78,6 +78,9 @@ struct Spring {
   uint8_t slab = 0;   // 0..2; a layer spring reports its upper slab
 };
 
+// The most a lid is held off its eyeball, in radii (SkinModel::eye_clearance).
+constexpr double kEyeClearance = 0.01;
+
 // An eyeball the lids slide over: a sphere fitted to an eye part.
 struct EyeSphere {
   int part = -1;                                     // scene part index
@@ -127,6 +130,17 @@ struct SkinModel {
   // lids and the skin around them. The solver holds its epidermal node off
   // the sphere instead of above the skull (what lies under a lid is the eye).
   std::vector<int8_t> eye_of;
+  // Per vertex: the eyeball whose sphere the solver holds its epidermal node
+  // outside of, or -1 (near_eyeballs(): eye_of and the skin facing away from
+  // the eye around it, such as the lid margin's underside, which meets the
+  // ball as the lid turns over it). A node of these that is not over the
+  // eyeball keeps its skull plane until it meets the sphere.
+  std::vector<int8_t> eye_near;
+  // Per vertex: how far off its eyeball's sphere the epidermal node is held
+  // (model units): its distance at rest, up to kEyeClearance radii. On the
+  // sphere itself the skin between nodes, a chord, and the eye part's
+  // vertices cross: Song's eyeball showed through the lid as dark specks.
+  std::vector<double> eye_clearance;
 
   int node(int layer, int vertex) const { return layer * n + vertex; }
   int layer_of(int node) const { return node / n; }
@@ -135,8 +149,33 @@ struct SkinModel {
   double stiffness(const Spring &s) const;
 };
 
+// The eyeballs of a scene: a sphere fitted to each eye part (left, then
+// right; an eye part whose vertices are not a sphere, within a tenth of its
+// radius rms, or with fewer than 8 vertices, is left out). `part` is set.
+std::vector<EyeSphere> fit_eyeballs(const Scene &scene);
+
+// Per vertex of a surface (V #V x 3, unit normals N #V x 3, `used`: #V, 0 for
+// a vertex no triangle uses): the eyeball in `eyes` it lies over, or -1 (the
+// first that qualifies). It lies over one when it is outside the sphere,
+// within half a radius of its surface, and the line inward along its normal
+// meets the sphere: the lids and the skin around them.
+std::vector<int8_t> over_eyeballs(const Eigen::MatrixXd &V, const Eigen::MatrixXd &N, const std::vector<uint8_t> &used,
+                                  const std::vector<EyeSphere> &eyes);
+
+// Per vertex of a surface (V #V x 3, `used` as above): the eyeball in `eyes`
+// whose sphere it lies outside of, within half a radius of its surface, or -1
+// (the first that qualifies). A superset of over_eyeballs(): it takes in the
+// lid margin's underside and the skin turning into the socket, which face
+// away from the eye but meet it as the lid turns over the ball.
+std::vector<int8_t> near_eyeballs(const Eigen::MatrixXd &V, const std::vector<uint8_t> &used,
+                                  const std::vector<EyeSphere> &eyes, double band = 0.5);
+
+// Area-weighted unit vertex normals of a triangle mesh (#V x 3; zero rows for
+// vertices no triangle uses).
+Eigen::MatrixXd vertex_normals(const Eigen::MatrixXd &V, const Eigen::MatrixXi &F);
+
 // Builds the tissue for scene part `part`; the scene's eye parts (if any)
-// become its eyeballs. Fails when the part has no
+// become its eyeballs (fit_eyeballs, over_eyeballs). Fails when the part has no
 // triangles, when its centre of gravity is on the surface (not a closed-ish
 // head), or when parameters are out of range (depths not 0 < d1 < d2 < 1,
 // skull_scale not in (0, 1)).

@@ -69,9 +69,11 @@ struct System {
         if (local[static_cast<size_t>(g)] >= 0) continue;
         local[static_cast<size_t>(g)] = static_cast<int>(nodes.size());
         nodes.push_back(g);
-        // Over an eyeball the epidermis slides on the eye, not the bone.
+        // Over an eyeball the epidermis slides on the eye, not the bone; near
+        // one (the lid margin's underside, the eye corners) it keeps its
+        // skull plane until it meets the ball (update_contacts).
         const int8_t over = l == kEpidermis ? m.eye_of[static_cast<size_t>(v)] : int8_t(-1);
-        eye.push_back(over);
+        eye.push_back(l == kEpidermis ? m.eye_near[static_cast<size_t>(v)] : int8_t(-1));
         rejects.push_back(over < 0 && skull_rejects(m, v) ? 1 : 0);
       }
     }
@@ -356,9 +358,11 @@ double total_energy(const System &sys, const ForceField &forces, const Eigen::Ma
   return e;
 }
 
-// Skull contacts: per local node, the constraint normal (zero: free).
+// Skull and eyeball contacts: per local node, the constraint normal (zero:
+// free), and whether it is the eyeball's.
 struct Contacts {
-  Eigen::MatrixXd normal;  // nodes x 3
+  Eigen::MatrixXd normal;       // nodes x 3
+  std::vector<uint8_t> on_eye;  // per node: held off its eyeball (else, with a normal, by its skull plane)
   int active = 0;
 
   void filter(Vec &v) const {
@@ -397,13 +401,16 @@ struct Contacts {
 };
 
 // Puts penetrating nodes back on their skull plane, or on the sphere of the
-// eyeball they lie over, and activates them. On an eyeball the constraint
-// plane is the sphere's tangent plane at the node, renewed at every update;
-// a held node is kept on the sphere. Returns the largest correction.
+// eyeball they lie near (grown by their clearance), and activates them. On
+// an eyeball the constraint plane is the sphere's tangent plane at the node,
+// renewed at every update; a held node is kept on the sphere. Returns the
+// largest correction.
 double update_contacts(const System &sys, Eigen::MatrixXd &X, Contacts &c) {
   const SkinModel &m = sys.m;
-  if (c.normal.rows() != static_cast<Eigen::Index>(sys.nodes.size()))
+  if (c.normal.rows() != static_cast<Eigen::Index>(sys.nodes.size())) {
     c.normal = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(sys.nodes.size()), 3);
+    c.on_eye.assign(sys.nodes.size(), 0);
+  }
   double moved = 0;
   c.active = 0;
   for (size_t i = 0; i < sys.nodes.size(); ++i) {
@@ -417,16 +424,21 @@ double update_contacts(const System &sys, Eigen::MatrixXd &X, Contacts &c) {
       const Eigen::Vector3d q = X.row(g).transpose() - e.centre;
       const double d = q.norm();
       if (!(d > 0)) continue;
-      const double gap = d - e.radius;
-      const bool on = was || gap < 0;
-      const Eigen::Vector3d nn = q / d;
-      if (on && gap != 0) {
-        X.row(g) -= gap * nn.transpose();
-        moved = std::max(moved, std::abs(gap));
+      const double gap = d - e.radius - m.eye_clearance[static_cast<size_t>(m.vertex_of(g))];
+      // Once on the eye, a node stays on it; a node that also has a skull
+      // plane leaves it for the eye when it meets the ball.
+      const bool on = (was && c.on_eye[i]) || gap < 0;
+      if (on || !sys.rejects[i]) {
+        const Eigen::Vector3d nn = q / d;
+        if (on && gap != 0) {
+          X.row(g) -= gap * nn.transpose();
+          moved = std::max(moved, std::abs(gap));
+        }
+        c.normal.row(row) = on ? Eigen::RowVector3d(nn.transpose()) : Eigen::RowVector3d::Zero();
+        c.on_eye[i] = on;
+        c.active += on;
+        continue;
       }
-      c.normal.row(row) = on ? Eigen::RowVector3d(nn.transpose()) : Eigen::RowVector3d::Zero();
-      c.active += on;
-      continue;
     }
     if (!sys.rejects[i]) continue;
     const int v = m.vertex_of(g);

@@ -36,10 +36,13 @@
 //             chatter). Skull-free vertices and vertices whose surface
 //             faces the centre of gravity (lip curls, nostrils) are never
 //             constrained;
-//   eyeballs  the epidermal node of a vertex over an eyeball
-//             (SkinModel::eye_of) is held off its sphere the same way: put
+//   eyeballs  the epidermal node of a vertex near an eyeball
+//             (SkinModel::eye_near) is held off its sphere, grown by the
+//             node's clearance (SkinModel::eye_clearance), the same way: put
 //             back on it when inside, then held with the sphere's tangent
-//             plane at the node, renewed at every update, as its plane.
+//             plane at the node, renewed at every update, as its plane. A
+//             node that also has a skull plane keeps it until it meets the
+//             sphere.
 //
 // Solvers (bench_builder compares them; docs/anatomy.md has the figures):
 //   newton          Newton's method on the static equations. The step solves

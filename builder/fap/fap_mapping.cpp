@@ -71,6 +71,9 @@ std::vector<FapMapping> make_table() {
     t[k].lid = t[k].fap <= 20 ? +1 : -1;
     t[k].fallback_positive = {{sphincter, 100}};
     t[k].fallback_negative = {{sphincter, -100}};
+    // Real streams close the upper lids to 1024 (the iris' diameter: shut
+    // on MPEG-4's neutral face) and the lower ones to 380-530.
+    t[k].farther = t[k].lid > 0 ? std::vector<int>{600, 1024} : std::vector<int>{600};
   }
   for (int f = 23; f <= 28; ++f) add(f, D::Rigid, 0, {}, {}, rigid_eye);
   add(29, D::None, 0, {}, {}, "pupil dilation needs pupil geometry, which the eye parts do not have");
@@ -224,6 +227,7 @@ std::string fap_mapping_text() {
     std::snprintf(head, sizeof head, "%2d %-22s %-10s", m.fap, info ? info->name : "?", fap_driver_name(m.driver));
     out += head;
     if (m.reference > 0) out += " ref " + std::to_string(m.reference);
+    for (int r : m.farther) out += "," + std::to_string(r);
     if (!m.positive.empty()) out += "  + " + group(m.positive);
     if (!m.negative.empty()) out += "  - " + group(m.negative);
     if (m.note && *m.note) out += std::string("  (") + m.note + ")";

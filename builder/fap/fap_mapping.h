@@ -53,6 +53,13 @@ struct FapMapping {
   // lid, -1 the lower, split at the height halfway between the lid centres
   // (3.1/3.3 or 3.2/3.4) and blended over the lids' opening. 0: not a lid.
   int lid = 0;
+  // In-between targets past `reference` on the positive side, FAP units,
+  // ascending (formats/afm.md: the player blends a side's targets piecewise
+  // linearly). For motions that turn rather than translate: a lid closing
+  // over its eyeball follows an arc, and one target extrapolated past its
+  // reference takes the lid along the chord, into the eyeball. Each is made
+  // only where the group reaches it in full; the report lists the others.
+  std::vector<int> farther;
 };
 
 // Every FAP 3..68 once, in number order.

@@ -189,6 +189,8 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     const FapMapping *fap = nullptr;
     const HighLevelMapping *high = nullptr;
     int side = +1;
+    int reference = 0;        // FAP units along `side` (> 0)
+    bool in_between = false;  // one of the mapping's `farther`
   };
   auto listed = [](const std::vector<int> &list, int n) {
     return std::find(list.begin(), list.end(), n) != list.end();
@@ -198,12 +200,13 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
   for (const FapMapping &m : fap_mappings()) {
     if (m.driver == FapDriver::Rigid || m.driver == FapDriver::None) continue;
     if (!everything && !listed(options.only, m.fap)) continue;
-    work.push_back({&m, nullptr, +1});
-    if (options.negative_sides && !m.negative.empty()) work.push_back({&m, nullptr, -1});
+    work.push_back({&m, nullptr, +1, m.reference});
+    for (int r : m.farther) work.push_back({&m, nullptr, +1, r, true});
+    if (options.negative_sides && !m.negative.empty()) work.push_back({&m, nullptr, -1, m.reference});
   }
   for (const HighLevelMapping &h : high_level_mappings())
     if (everything || listed(h.expression ? options.only_expressions : options.only_visemes, h.number))
-      work.push_back({nullptr, &h, +1});
+      work.push_back({nullptr, &h, +1, 63});
 
   out.jaw.kind = AFM_RIGID_JAW;
   out.jaw.pivot = model.jaw.pivot;
@@ -368,16 +371,17 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     Result &res = results[k];
     if (work[k].high) return make_high_level(*work[k].high, res);
     const FapMapping *map = work[k].fap;
-    const int side = work[k].side;
+    const int side = work[k].side, reference = work[k].reference;
     const auto start = std::chrono::steady_clock::now();
     const afm_fap_info *info = afm_fap(map->fap);
     FapOutcome o;
     o.number = map->fap;
     o.side = side;
-    o.reference = side * map->reference;
+    o.reference = side * reference;
+    o.in_between = work[k].in_between;
     const Eigen::Vector3d dir = fap_direction(info);
     const double unit = fapu_distance(model.fapu, info->unit) / 1024.0;
-    const double value = map->reference * unit;  // along side x dir
+    const double value = reference * unit;  // along side x dir
     bool fallback = false;  // the FAP acts through its fallback group
     o.prescribed = side * value * dir;
     const FdpPoint *fdp = model.fdps.find(FdpId{info->fdp_group, info->fdp_index}, model.skin);
@@ -552,7 +556,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
             if (r < 1) {
               o.message = reach <= 0 ? "the group moves the FDP the wrong way"
                                      : "the group moves the FDP less than a FAP unit";
-              o.message += " (reference " + std::to_string(map->reference) + ": " + why + ")";
+              o.message += " (reference " + std::to_string(reference) + ": " + why + ")";
             } else {
               // Kept at the table's reference: the target is the most the
               // group does, so streams at the reference see the muscles at
@@ -575,6 +579,13 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
           }
         }
       }
+    }
+    if (ok && o.in_between && o.reached < 1) {
+      // Only where the group reaches it in full. Made at what it reaches
+      // instead, the generated 2k head's upper lid (449 of 600) took its
+      // pose's chord past 449 2.7 mm into the eyeball at 1024, against
+      // 0.4 mm with the reference target alone extrapolated.
+      ok = false;
     }
     if (ok) {
       Eigen::MatrixXd D = shrink * (pose_epidermis(model, pose) - skin.X0.topRows(skin.n));
@@ -609,7 +620,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     for (const FapContraction &c : fap_group(model, *f, work[k].side)) group.push_back({c.muscle, c.percent});
     const Eigen::Vector3d along = work[k].side * fap_direction(info);
     keys[k] = SolveKey{group, p->vertex, along.x(), along.y(), along.z(),
-                       f->reference * fapu_distance(model.fapu, info->unit), f->lid};
+                       work[k].reference * fapu_distance(model.fapu, info->unit), f->lid};
   }
   std::vector<size_t> same_as(work.size());
   for (size_t k = 0; k < work.size(); ++k) {
@@ -633,7 +644,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     r.outcome = first.outcome;
     r.outcome.number = work[k].fap->fap;
     r.outcome.side = work[k].side;
-    r.outcome.reference = work[k].side * work[k].fap->reference;
+    r.outcome.reference = work[k].side * work[k].reference;
     r.outcome.seconds = 0;
     if (first.target) {
       r.target = first.target;
@@ -646,7 +657,8 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     std::vector<SharingTarget> sharing(work.size());
     for (size_t k = 0; k < work.size(); ++k) {
       const FapMapping *f = work[k].fap;
-      if (!f || f->driver != FapDriver::Muscles || f->lid || !results[k].target) continue;
+      // (Lids share no skin, and only they have in-betweens.)
+      if (!f || f->driver != FapDriver::Muscles || f->lid || work[k].in_between || !results[k].target) continue;
       const afm_fap_info *info = afm_fap(f->fap);
       const FdpPoint *p = model.fdps.find(FdpId{info->fdp_group, info->fdp_index}, model.skin);
       if (!p || p->part != model.skin || p->vertex < 0) continue;
@@ -684,7 +696,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
             sharing[j].direction != sharing[k].direction ||
             part.weight[j].size() == 0)
           continue;
-        achieved += static_cast<double>(work[k].fap->reference) / work[j].fap->reference *
+        achieved += static_cast<double>(work[k].reference) / work[j].reference *
                     results[j].target->displacement[sk].row(v).transpose();
         with += (with.empty() ? "" : ", ") + std::to_string(sharing[j].fap);
       }

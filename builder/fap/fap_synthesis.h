@@ -11,6 +11,11 @@
 // the pose of the largest motion solved so far not past its own); the jaw's rigid parts
 // (lower teeth, tongue) get a control with the same motion.
 //
+// In-betweens (FapMapping::farther; formats/afm.md): the same solve at each
+// farther reference, kept only where the group reaches it in full. The
+// player blends a side's targets piecewise linearly, so a lid follows its
+// arc over the eyeball up to there.
+//
 // FAP targets that move the same skin (the inner and outer lip FAPs, the
 // midlip and mid-left/right ones, the brows, ...) then split it between
 // them (fap_partition.h), so that a stream sending them together moves each
@@ -81,6 +86,7 @@ struct FapOutcome {
   int number = 0;                 // FAP 3..68, viseme 1..14 or expression 1..6, after `kind`
   int side = +1;                  // +1: the positive reference, -1: the negative one
   int reference = 0;              // signed FAP units (63 for visemes and expressions)
+  bool in_between = false;        // one of FapMapping::farther (made only where reached in full)
   bool made = false;              // a target was made
   std::string message;            // why not, when !made; how far it reaches when it under-reaches
   double reached = 1;             // the achieved share of the prescribed motion along the

@@ -98,14 +98,20 @@ Eigen::Vector3d moved(const FaceModel &model, const Eigen::MatrixXd &X, const ch
 
 double mm(double metres) { return metres * 1000; }
 
-// The deepest any lid's epidermis goes into its eyeball at X, model units
-// (negative: all clear of them).
+// How far the skin went into its eyeballs, model units: the largest depth of an epidermal
+// node below its sphere grown by the node's clearance (skin_model.h:
+// min(distance at rest, a hundredth of the radius)), over every skin vertex
+// outside the sphere at rest within 1.5 radii of its centre (the lids and
+// the skin around them, whichever way they face). Negative when none.
 double deepest_in_eyes(const FaceModel &m, const Eigen::MatrixXd &X) {
   double d = -1;
-  for (int v = 0; v < m.tissue.n; ++v)
-    if (const int e = m.tissue.eye_of[static_cast<size_t>(v)]; e >= 0) {
-      const EyeSphere &s = m.tissue.eyes[static_cast<size_t>(e)];
-      d = std::max(d, s.radius - (X.row(v).transpose() - s.centre).norm());
+  for (const EyeSphere &s : m.tissue.eyes)
+    for (int v = 0; v < m.tissue.n; ++v) {
+      if (!m.tissue.in_mesh[static_cast<size_t>(v)]) continue;
+      const double rest = (m.tissue.X0.row(v).transpose() - s.centre).norm();
+      if (rest < s.radius || rest > 1.5 * s.radius) continue;
+      const double held = s.radius + std::min(rest - s.radius, 0.01 * s.radius);
+      d = std::max(d, held - (X.row(v).transpose() - s.centre).norm());
     }
   return d;
 }
@@ -455,6 +461,7 @@ TEST(Physics, TheLidsSlideOverTheEyeball) {
   FaceModel free = m;  // the same model without the eyeballs
   free.tissue.eyes.clear();
   std::fill(free.tissue.eye_of.begin(), free.tissue.eye_of.end(), int8_t(-1));
+  std::fill(free.tissue.eye_near.begin(), free.tissue.eye_near.end(), int8_t(-1));
   const Eigen::MatrixXd Y = contract(free, "orbicularis_oculi_left", t);
   EXPECT_GT(deepest(Y), 0.05 * design.eye_radius) << "without the contact the lid goes into the eye";
 }

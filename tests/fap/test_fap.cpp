@@ -11,6 +11,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <memory>
 
 #include "afm/afm_export.h"
@@ -988,6 +989,76 @@ TEST(HighLevel, SongsEyeSphinctersCalibrateAlikeAndKeepTheSkinWhole) {
     }
 }
 
+// Song's left lids, as afm-build makes them: FAPs 19 and 21 get an
+// in-between target at 600 besides the one at 300 (fap_mapping.h: the lids
+// close to 1024 in real streams), both reached in full, and in every target
+// and half-way between two, as the player blends them, no skin vertex of the
+// whole skin (carried from the simulation mesh) goes into its eyeball. Held
+// only where the inward normal meets the ball, the upper lid margin's
+// underside went 0.3 units in at 600, the lifted skin above it 0.13 units at
+// 300; held on the sphere itself, the eye showed through as dark specks.
+TEST(FapSynthesis, SongsLidsCloseOverTheEyeballInBetweenTargetsIncluded) {
+  AFM_REQUIRE_SHARED_DATA();
+  Expected<LoadedFace> f = load_face(afmtest::shared_data("faces/song/song.WRL"),
+                                     afmtest::shared_data("faces/song/song.fdp"), LoadOptions{}, nullptr);
+  ASSERT_TRUE(f.is_ok()) << f.status().message();
+  FaceModelOptions fo;
+  fo.calibrate_only = {"palpebral_upper_left", "palpebral_lower_left"};
+  fo.calibrate_jaw = false;
+  Expected<SimFaceModel> sm = build_sim_face_model(f->scene, f->fdps, SimMeshOptions{kDefaultSimVertices}, fo);
+  ASSERT_TRUE(sm.is_ok()) << sm.status().message();
+  FapSynthesisOptions o;
+  o.only = {19, 21};
+  Expected<FapSynthesis> syn = synthesize_faps(sm->scene, sm->model, o);
+  ASSERT_TRUE(syn.is_ok()) << syn.status().message();
+  lift_synthesis(*syn, sm->sim);
+
+  const int skin = sm->sim.skin;
+  const Eigen::MatrixXd &V = f->scene.parts[static_cast<size_t>(skin)].V;
+  const std::vector<EyeSphere> eyes = fit_eyeballs(f->scene);
+  ASSERT_EQ(eyes.size(), 2u);
+  // The deepest a skin vertex outside a sphere at rest (within 1.5 radii)
+  // goes into it under displacement D (#V x 3).
+  auto deepest = [&](const Eigen::MatrixXd &D) {
+    double d = -1;
+    for (const EyeSphere &e : eyes)
+      for (Eigen::Index v = 0; v < V.rows(); ++v) {
+        const double rest = (V.row(v).transpose() - e.centre).norm();
+        if (rest < e.radius || rest > 1.5 * e.radius) continue;
+        d = std::max(d, e.radius - (V.row(v) + D.row(v) - e.centre.transpose()).norm());
+      }
+    return d;
+  };
+  std::map<std::pair<int, int>, const MorphTarget *> by;  // (FAP, reference)
+  size_t next = 0;
+  for (const FapOutcome &out : syn->outcomes) {
+    if (!out.made) continue;
+    by[{out.number, out.reference}] = &syn->targets[next++];
+  }
+  for (int fap : {19, 21}) {
+    ASSERT_TRUE(by.count({fap, 300})) << "FAP " << fap << " at 300";
+    ASSERT_TRUE(by.count({fap, 600})) << "FAP " << fap << " has its in-between at 600";
+    const Eigen::MatrixXd &a = by[{fap, 300}]->displacement[static_cast<size_t>(skin)];
+    const Eigen::MatrixXd &b = by[{fap, 600}]->displacement[static_cast<size_t>(skin)];
+    ASSERT_EQ(a.rows(), V.rows());
+    ASSERT_EQ(b.rows(), V.rows());
+    // The lid at 600 is on its way: twice as far down at its FDP.
+    const afm_fap_info *info = afm_fap(fap);
+    const FdpPoint *p = f->fdps.find(FdpId{info->fdp_group, info->fdp_index}, skin);
+    ASSERT_NE(p, nullptr);
+    const Eigen::Vector3d dir = fap_direction(info);
+    EXPECT_NEAR(b.row(p->vertex).dot(dir.transpose()), 2 * a.row(p->vertex).dot(dir.transpose()),
+                0.05 * b.row(p->vertex).norm())
+        << "FAP " << fap;
+    const double q = sm->model.quantum;
+    EXPECT_LE(deepest(a), q) << "FAP " << fap << " at 300";
+    EXPECT_LE(deepest(0.5 * (a + b)), q) << "FAP " << fap << " at 450 (blended)";
+    EXPECT_LE(deepest(b), q) << "FAP " << fap << " at 600";
+    std::printf("FAP %d: deepest into the eyeball at 300 / 450 / 600: %.4f / %.4f / %.4f units\n", fap, deepest(a),
+                deepest(0.5 * (a + b)), deepest(b));
+  }
+}
+
 // Joy on the generated 2k head, simulated on 1,000 vertices, folds the
 // cheeks over (0.08 % of the skin's area turned) where the zygomatici act.
 // Only the muscles to blame are reduced: risorius, the eye sphincters and
@@ -1050,12 +1121,19 @@ TEST(HighLevel, AnExpressionThatTearsTheSkinReducesTheMusclesThatTearIt) {
   ASSERT_EQ(reduced.rows(), D.rows());
   EXPECT_TRUE(skin_faults(m, X0 + table).tears());
   // The target's pose was solved from the bisection's last share, this one
-  // from rest: both within the solver's tolerance, 3 quanta apart at most
-  // where the cheeks fold (measured), while the table's pose lies far away.
-  EXPECT_LT((D - reduced).rowwise().norm().maxCoeff(), 4 * m.quantum);
+  // from rest, while the table's pose lies far away. The two were 3 quanta
+  // apart at most where the cheeks fold (measured) until the lids were held
+  // a hundredth of a radius off the eyeballs (skin_model.h): squeezed onto
+  // them by the eye sphincters, the lower lids have two equilibria, and the
+  // start picks one, 29 quanta (0.14 mm) apart at a lower-lid vertex, 9 at
+  // the skin beside it (measured; a solver tolerance ten times finer gives
+  // the same two poses).
+  const double apart = (D - reduced).rowwise().norm().maxCoeff();
+  const double table_apart = (table - reduced).rowwise().norm().maxCoeff();
+  EXPECT_LT(apart, 40 * m.quantum);
   std::printf("joy on the 2k head: the target and the reduced pose %.1f quanta apart, the table's pose %.1f\n",
-              (D - reduced).rowwise().norm().maxCoeff() / m.quantum,
-              (table - reduced).rowwise().norm().maxCoeff() / m.quantum);
+              apart / m.quantum, table_apart / m.quantum);
+  EXPECT_GT(table_apart, 10 * apart);
   EXPECT_GT((table - reduced).rowwise().norm().maxCoeff(), 10 * m.quantum);
 }
 
