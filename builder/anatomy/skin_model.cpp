@@ -74,21 +74,25 @@ std::optional<EyeSphere> fit_sphere(const Eigen::MatrixXd &P) {
   return s;
 }
 
-}  // namespace
-
-std::vector<EyeSphere> fit_eyeballs(const Scene &scene) {
-  std::vector<EyeSphere> eyes;
-  for (PartKind kind : {PartKind::EyeLeft, PartKind::EyeRight}) {
-    const int e = scene.find_kind(kind);
-    if (e < 0) continue;
-    std::optional<EyeSphere> ball = fit_sphere(scene.parts[static_cast<size_t>(e)].V);
-    if (!ball) continue;
-    ball->part = e;
-    eyes.push_back(*ball);
+// Area-weighted unit vertex normals (#V x 3; zero rows for vertices no
+// triangle uses).
+Eigen::MatrixXd vertex_normals(const Eigen::MatrixXd &V, const Eigen::MatrixXi &F) {
+  Eigen::MatrixXd N = Eigen::MatrixXd::Zero(V.rows(), 3);
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), d = V.row(F(f, 2));
+    const Eigen::Vector3d nrm = (b - a).cross(d - a);  // twice the area
+    for (int k = 0; k < 3; ++k) N.row(F(f, k)) += nrm.transpose();
   }
-  return eyes;
+  for (Eigen::Index v = 0; v < V.rows(); ++v) {
+    const double len = N.row(v).norm();
+    if (len > 0) N.row(v) /= len;
+  }
+  return N;
 }
 
+// Per vertex of V (#V x 3, unit normals N): the eyeball in `eyes` it lies
+// over, or -1 (SkinModel::eye_of: outside the sphere, within half a radius
+// of its surface, and the line inward along its normal meets the sphere).
 std::vector<int8_t> over_eyeballs(const Eigen::MatrixXd &V, const Eigen::MatrixXd &N, const std::vector<uint8_t> &used,
                                   const std::vector<EyeSphere> &eyes) {
   std::vector<int8_t> out(static_cast<size_t>(V.rows()), -1);
@@ -106,6 +110,21 @@ std::vector<int8_t> over_eyeballs(const Eigen::MatrixXd &V, const Eigen::MatrixX
   return out;
 }
 
+}  // namespace
+
+std::vector<EyeSphere> fit_eyeballs(const Scene &scene) {
+  std::vector<EyeSphere> eyes;
+  for (PartKind kind : {PartKind::EyeLeft, PartKind::EyeRight}) {
+    const int e = scene.find_kind(kind);
+    if (e < 0) continue;
+    std::optional<EyeSphere> ball = fit_sphere(scene.parts[static_cast<size_t>(e)].V);
+    if (!ball) continue;
+    ball->part = e;
+    eyes.push_back(*ball);
+  }
+  return eyes;
+}
+
 std::vector<int8_t> near_eyeballs(const Eigen::MatrixXd &V, const std::vector<uint8_t> &used,
                                   const std::vector<EyeSphere> &eyes, double band) {
   std::vector<int8_t> out(static_cast<size_t>(V.rows()), -1);
@@ -116,20 +135,6 @@ std::vector<int8_t> near_eyeballs(const Eigen::MatrixXd &V, const std::vector<ui
       if (d >= eyes[eye].radius && d <= (1 + band) * eyes[eye].radius) out[static_cast<size_t>(v)] = static_cast<int8_t>(eye);
     }
   return out;
-}
-
-Eigen::MatrixXd vertex_normals(const Eigen::MatrixXd &V, const Eigen::MatrixXi &F) {
-  Eigen::MatrixXd N = Eigen::MatrixXd::Zero(V.rows(), 3);
-  for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), d = V.row(F(f, 2));
-    const Eigen::Vector3d nrm = (b - a).cross(d - a);  // twice the area
-    for (int k = 0; k < 3; ++k) N.row(F(f, k)) += nrm.transpose();
-  }
-  for (Eigen::Index v = 0; v < V.rows(); ++v) {
-    const double len = N.row(v).norm();
-    if (len > 0) N.row(v) /= len;
-  }
-  return N;
 }
 
 Expected<SkinModel> build_skin_model(const Scene &scene, int part, const TissueParams &params) {

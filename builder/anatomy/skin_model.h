@@ -154,28 +154,17 @@ struct SkinModel {
 // radius rms, or with fewer than 8 vertices, is left out). `part` is set.
 std::vector<EyeSphere> fit_eyeballs(const Scene &scene);
 
-// Per vertex of a surface (V #V x 3, unit normals N #V x 3, `used`: #V, 0 for
-// a vertex no triangle uses): the eyeball in `eyes` it lies over, or -1 (the
-// first that qualifies). It lies over one when it is outside the sphere,
-// within half a radius of its surface, and the line inward along its normal
-// meets the sphere: the lids and the skin around them.
-std::vector<int8_t> over_eyeballs(const Eigen::MatrixXd &V, const Eigen::MatrixXd &N, const std::vector<uint8_t> &used,
-                                  const std::vector<EyeSphere> &eyes);
-
-// Per vertex of a surface (V #V x 3, `used` as above): the eyeball in `eyes`
-// whose sphere it lies outside of, within half a radius of its surface, or -1
-// (the first that qualifies). A superset of over_eyeballs(): it takes in the
-// lid margin's underside and the skin turning into the socket, which face
-// away from the eye but meet it as the lid turns over the ball.
+// Per vertex of a surface (V #V x 3; `used`: #V, 0 for a vertex no triangle
+// uses): the eyeball in `eyes` whose sphere it lies outside of, within `band`
+// radii of its surface, or -1 (the first that qualifies). With the default
+// band, a superset of SkinModel::eye_of: it takes in the lid margin's
+// underside and the skin turning into the socket, which face away from the
+// eye but meet it as the lid turns over the ball.
 std::vector<int8_t> near_eyeballs(const Eigen::MatrixXd &V, const std::vector<uint8_t> &used,
                                   const std::vector<EyeSphere> &eyes, double band = 0.5);
 
-// Area-weighted unit vertex normals of a triangle mesh (#V x 3; zero rows for
-// vertices no triangle uses).
-Eigen::MatrixXd vertex_normals(const Eigen::MatrixXd &V, const Eigen::MatrixXi &F);
-
 // Builds the tissue for scene part `part`; the scene's eye parts (if any)
-// become its eyeballs (fit_eyeballs, over_eyeballs). Fails when the part has no
+// become its eyeballs (fit_eyeballs, near_eyeballs). Fails when the part has no
 // triangles, when its centre of gravity is on the surface (not a closed-ish
 // head), or when parameters are out of range (depths not 0 < d1 < d2 < 1,
 // skull_scale not in (0, 1)).
