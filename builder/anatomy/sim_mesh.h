@@ -28,9 +28,10 @@
 // from the skin normals it covers, leave a skin vertex more than 0.03 eye
 // separations from the coarse surface, or leave a triangle of aspect ratio
 // above 5, and the mesh stays a manifold with the same boundaries (the
-// mouth slit and eye openings). A mirror-symmetric skin (nine in ten vertices with a mirror
-// image) keeps mirror images: FDP vertices lock their images, the sizing is
-// symmetric and ties break the same way on both sides (docs/anatomy.md).
+// mouth slit and eye openings). A mirror-symmetric skin (nine in ten
+// vertices with a mirror image) keeps mirror images: FDP vertices lock their
+// images, the sizing is symmetric and ties break the same way on both sides
+// (docs/anatomy.md).
 //
 // Each skin vertex is bound to the nearest point of the coarse triangles
 // around its nearest kept vertex along the skin's edges, so a vertex of the

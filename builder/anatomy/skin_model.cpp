@@ -281,15 +281,16 @@ Expected<SkinModel> build_skin_model(const Scene &scene, int part, const TissueP
   m.eye_clearance.assign(static_cast<size_t>(n), 0.0);
   for (int v = 0; v < n; ++v) {
     const int8_t over = m.eye_of[static_cast<size_t>(v)];
-    if (over >= 0) m.eye_near[static_cast<size_t>(v)] = over;
+    if (over >= 0) {  // what lies under it is the eye, not bone
+      m.skull_free[static_cast<size_t>(v)] = 1;
+      m.eye_near[static_cast<size_t>(v)] = over;
+    }
     if (const int8_t e = m.eye_near[static_cast<size_t>(v)]; e >= 0) {
       const EyeSphere &ball = m.eyes[static_cast<size_t>(e)];
       const double rest = (p.V.row(v).transpose() - ball.centre).norm() - ball.radius;
       m.eye_clearance[static_cast<size_t>(v)] = std::clamp(rest, 0.0, kEyeClearance * ball.radius);
     }
   }
-  for (int v = 0; v < n; ++v)
-    if (m.eye_of[static_cast<size_t>(v)] >= 0) m.skull_free[static_cast<size_t>(v)] = 1;
   return m;
 }
 

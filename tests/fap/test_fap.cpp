@@ -943,19 +943,33 @@ TEST(FapSynthesis, TargetsMadeOnACoarserSimulationMeshMatchTheSkins) {
   EXPECT_NE(refused.status().message().find("not finite"), std::string::npos) << refused.status().message();
 }
 
+// Song as afm-build models it, on its default simulation mesh, with only
+// `muscles` calibrated and no jaw; the loaded face (its whole skin) beside it.
+struct SongOnSimMesh {
+  LoadedFace face;
+  SimFaceModel built;
+};
+SongOnSimMesh song_on_sim_mesh(const std::vector<std::string> &muscles) {
+  SongOnSimMesh out;
+  Expected<LoadedFace> f = load_face(afmtest::shared_data("faces/song/song.WRL"),
+                                     afmtest::shared_data("faces/song/song.fdp"), LoadOptions{}, nullptr);
+  EXPECT_TRUE(f.is_ok()) << f.status().message();
+  if (!f.is_ok()) return out;
+  out.face = std::move(*f);
+  FaceModelOptions fo;
+  fo.calibrate_only = muscles;
+  fo.calibrate_jaw = false;
+  Expected<SimFaceModel> m =
+      build_sim_face_model(out.face.scene, out.face.fdps, SimMeshOptions{kDefaultSimVertices}, fo);
+  EXPECT_TRUE(m.is_ok()) << m.status().message();
+  if (m.is_ok()) out.built = std::move(*m);
+  return out;
+}
+
 // Song on afm-build's simulation mesh, its eye sphincters calibrated.
 const SimFaceModel &song_eyes_model() {
-  static const SimFaceModel built = [] {
-    Expected<LoadedFace> f = load_face(afmtest::shared_data("faces/song/song.WRL"),
-                                       afmtest::shared_data("faces/song/song.fdp"), LoadOptions{}, nullptr);
-    EXPECT_TRUE(f.is_ok()) << f.status().message();
-    FaceModelOptions fo;
-    fo.calibrate_only = {"orbicularis_oculi_left", "orbicularis_oculi_right"};
-    fo.calibrate_jaw = false;
-    Expected<SimFaceModel> m = build_sim_face_model(f->scene, f->fdps, SimMeshOptions{1000}, fo);
-    EXPECT_TRUE(m.is_ok()) << m.status().message();
-    return m.is_ok() ? std::move(*m) : SimFaceModel{};
-  }();
+  static const SimFaceModel built =
+      song_on_sim_mesh({"orbicularis_oculi_left", "orbicularis_oculi_right"}).built;
   return built;
 }
 
@@ -999,23 +1013,19 @@ TEST(HighLevel, SongsEyeSphinctersCalibrateAlikeAndKeepTheSkinWhole) {
 // 300; held on the sphere itself, the eye showed through as dark specks.
 TEST(FapSynthesis, SongsLidsCloseOverTheEyeballInBetweenTargetsIncluded) {
   AFM_REQUIRE_SHARED_DATA();
-  Expected<LoadedFace> f = load_face(afmtest::shared_data("faces/song/song.WRL"),
-                                     afmtest::shared_data("faces/song/song.fdp"), LoadOptions{}, nullptr);
-  ASSERT_TRUE(f.is_ok()) << f.status().message();
-  FaceModelOptions fo;
-  fo.calibrate_only = {"palpebral_upper_left", "palpebral_lower_left"};
-  fo.calibrate_jaw = false;
-  Expected<SimFaceModel> sm = build_sim_face_model(f->scene, f->fdps, SimMeshOptions{kDefaultSimVertices}, fo);
-  ASSERT_TRUE(sm.is_ok()) << sm.status().message();
+  const SongOnSimMesh song = song_on_sim_mesh({"palpebral_upper_left", "palpebral_lower_left"});
+  ASSERT_FALSE(HasFailure());
+  const LoadedFace &f = song.face;
+  const SimFaceModel &sm = song.built;
   FapSynthesisOptions o;
   o.only = {19, 21};
-  Expected<FapSynthesis> syn = synthesize_faps(sm->scene, sm->model, o);
+  Expected<FapSynthesis> syn = synthesize_faps(sm.scene, sm.model, o);
   ASSERT_TRUE(syn.is_ok()) << syn.status().message();
-  lift_synthesis(*syn, sm->sim);
+  lift_synthesis(*syn, sm.sim);
 
-  const int skin = sm->sim.skin;
-  const Eigen::MatrixXd &V = f->scene.parts[static_cast<size_t>(skin)].V;
-  const std::vector<EyeSphere> eyes = fit_eyeballs(f->scene);
+  const int skin = sm.sim.skin;
+  const Eigen::MatrixXd &V = f.scene.parts[static_cast<size_t>(skin)].V;
+  const std::vector<EyeSphere> eyes = fit_eyeballs(f.scene);
   ASSERT_EQ(eyes.size(), 2u);
   // The deepest a skin vertex outside a sphere at rest (within 1.5 radii)
   // goes into it under displacement D (#V x 3).
@@ -1044,13 +1054,13 @@ TEST(FapSynthesis, SongsLidsCloseOverTheEyeballInBetweenTargetsIncluded) {
     ASSERT_EQ(b.rows(), V.rows());
     // The lid at 600 is on its way: twice as far down at its FDP.
     const afm_fap_info *info = afm_fap(fap);
-    const FdpPoint *p = f->fdps.find(FdpId{info->fdp_group, info->fdp_index}, skin);
+    const FdpPoint *p = f.fdps.find(FdpId{info->fdp_group, info->fdp_index}, skin);
     ASSERT_NE(p, nullptr);
     const Eigen::Vector3d dir = fap_direction(info);
     EXPECT_NEAR(b.row(p->vertex).dot(dir.transpose()), 2 * a.row(p->vertex).dot(dir.transpose()),
                 0.05 * b.row(p->vertex).norm())
         << "FAP " << fap;
-    const double q = sm->model.quantum;
+    const double q = sm.model.quantum;
     EXPECT_LE(deepest(a), q) << "FAP " << fap << " at 300";
     EXPECT_LE(deepest(0.5 * (a + b)), q) << "FAP " << fap << " at 450 (blended)";
     EXPECT_LE(deepest(b), q) << "FAP " << fap << " at 600";
@@ -1134,7 +1144,7 @@ TEST(HighLevel, AnExpressionThatTearsTheSkinReducesTheMusclesThatTearIt) {
   std::printf("joy on the 2k head: the target and the reduced pose %.1f quanta apart, the table's pose %.1f\n",
               apart / m.quantum, table_apart / m.quantum);
   EXPECT_GT(table_apart, 10 * apart);
-  EXPECT_GT((table - reduced).rowwise().norm().maxCoeff(), 10 * m.quantum);
+  EXPECT_GT(table_apart, 10 * m.quantum);
 }
 
 TEST(FapSynthesis, TheAfmHoldsTheTargetsAndTheJaw) {
