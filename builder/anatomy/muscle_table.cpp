@@ -22,6 +22,12 @@ using K = MuscleKind;
 //  - orbicularis_oris: the paper's epicentre (n + m) / 2 with n = 8.2,
 //    m = 8.3 lies between the lower lip and the left corner; the mouth's
 //    centre, halfway between 8.1 and 8.2, here.
+//  - corrugator: the paper's fibre 4.3 -> 4.3 + (4.3 - 4.1) lies a brow
+//    segment lateral of the anatomical one, and the inner brow 4.1, which
+//    FAPs 37/38 move, lies behind its attachment, outside its influence
+//    area. Anatomically it rises from the bone at the brows' inner ends and
+//    inserts in the mid-brow skin: attachment a third of the way from 4.1
+//    to 4.2, insertion 4.3.
 const std::vector<MuscleDef> kTable = {
     {"frontalis_inner_left", K::Linear, "11.1 + 1/6 (11.3 - 11.1)", "4.1", nullptr, 0.30, +1, 0.18, 0.06, false, false, false},
     {"frontalis_inner_right", K::Linear, "11.1 + 1/6 (11.2 - 11.1)", "4.2", nullptr, 0.30, +1, 0.18, 0.06, false, false, false},
@@ -29,8 +35,8 @@ const std::vector<MuscleDef> kTable = {
     {"frontalis_major_right", K::Linear, "11.1 + 1/3 (11.2 - 11.1)", "4.4", nullptr, 0.30, +1, 0.18, 0.06, false, false, false},
     {"frontalis_outer_left", K::Linear, "11.1 + 2/3 (11.3 - 11.1)", "4.5", nullptr, 0.30, +1, 0.18, 0.06, false, false, false},
     {"frontalis_outer_right", K::Linear, "11.1 + 2/3 (11.2 - 11.1)", "4.6", nullptr, 0.30, +1, 0.18, 0.06, false, false, false},
-    {"corrugator_left", K::Linear, "4.3", "4.3 + (4.3 - 4.1)", nullptr, 0.40, +1, 0.25, 0.08, false, false, false},
-    {"corrugator_right", K::Linear, "4.4", "4.4 + (4.4 - 4.2)", nullptr, 0.40, +1, 0.25, 0.08, false, false, false},
+    {"corrugator_left", K::Linear, "4.1 + 1/3 (4.2 - 4.1)", "4.3", nullptr, 0.40, +1, 0.25, 0.08, false, false, false},
+    {"corrugator_right", K::Linear, "4.2 + 1/3 (4.1 - 4.2)", "4.4", nullptr, 0.40, +1, 0.25, 0.08, false, false, false},
     {"nasalis_left", K::Linear, "9.7", "9.1", nullptr, 0.30, +1, 0.15, 0.05, false, false, false},
     {"nasalis_right", K::Linear, "9.6", "9.2", nullptr, 0.30, +1, 0.15, 0.05, false, false, false},
     {"upper_lip_left", K::Linear, "9.5 + 1/2 (9.15 - 9.5)", "8.10", nullptr, 0.40, -1, 0.40, 0.15, false, true, false},

@@ -85,8 +85,10 @@ std::vector<FapMapping> make_table() {
   add(34, D::Muscles, 150, {{"frontalis_major_right", 100}}, {{"frontalis_major_right", -100}}, "");
   add(35, D::Muscles, 110, {{"frontalis_outer_left", 100}}, {{"frontalis_outer_left", -100}}, "");
   add(36, D::Muscles, 110, {{"frontalis_outer_right", 100}}, {{"frontalis_outer_right", -100}}, "");
-  add(37, D::Muscles, 200, {{"corrugator_left", 100}}, {{"corrugator_left", -100}}, "");
-  add(38, D::Muscles, 200, {{"corrugator_right", 100}}, {{"corrugator_right", -100}}, "");
+  // Squeezing takes half the streams' 90th percentile: at 200 the inner brow
+  // would nearly reach the corrugator's attachment (docs/fap_mapping.md).
+  add(37, D::Muscles, 100, {{"corrugator_left", 100}}, {{"corrugator_left", -100}}, "");
+  add(38, D::Muscles, 100, {{"corrugator_right", 100}}, {{"corrugator_right", -100}}, "");
   // ---- group 5: cheeks ----
   add(39, D::None, 0, {}, {}, "a puffed cheek is air pressure, not a muscle");
   add(40, D::None, 0, {}, {}, "a puffed cheek is air pressure, not a muscle");

@@ -409,6 +409,12 @@ TEST(Physics, EachMuscleMovesItsRegionTheWayAnatomySays) {
     const Eigen::Vector3d d = X.row(v) - m.tissue.X0.row(v);
     EXPECT_LT(d.x(), -0.1e-3) << "corrugator pulls the (left) brow toward the midline";
     EXPECT_GT(m.tissue.X0(v, 0), 0.0);
+    // The inner brow goes with it, in and down (a frown, FACS AU 4). With the
+    // paper's fibre (4.3 -> 4.3 + (4.3 - 4.1)) 4.1 lay behind the attachment,
+    // out of its influence area (docs/anatomy.md).
+    const Eigen::Vector3d inner = moved(m, X, "4.1");
+    EXPECT_LT(inner.x(), -0.1e-3) << "corrugator draws the inner brow toward the midline";
+    EXPECT_LT(inner.y(), 0.0) << "and down";
   }
   {
     const Eigen::MatrixXd X = contract(m, "mentalis_left", t);
