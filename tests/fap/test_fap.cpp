@@ -256,9 +256,6 @@ TEST(FapSynthesis, TheCornerGoesUpForPositiveValuesAndDownForNegativeOnes) {
   EXPECT_LT(down->displacement[static_cast<size_t>(m.skin)](corner->vertex, 1), 0);
 }
 
-// Viseme A: opens the jaw by its table's FAP 3 value: the chin drops by
-// value x MNS / 1024 as the bone carries it (the skin over it within 15 %),
-// and the lower teeth move with the bone, rigidly.
 // FAP 37 squeezes the inner brow (4.1) toward the midline: the corrugator
 // draws it from the glabella (docs/anatomy.md). With the paper's fibre, 4.3 ->
 // 4.3 + (4.3 - 4.1), 4.1 lay behind the attachment and moved by less than a
@@ -287,6 +284,9 @@ TEST(FapSynthesis, TheCorrugatorSqueezesTheInnerBrowTowardTheMidline) {
   EXPECT_LE(d.y(), 0.0);
 }
 
+// Viseme A: opens the jaw by its table's FAP 3 value: the chin drops by
+// value x MNS / 1024 as the bone carries it (the skin over it within 15 %),
+// and the lower teeth move with the bone, rigidly.
 TEST(HighLevel, VisemeAOpensTheJawByItsTableValueAndCarriesTheTeeth) {
   const FaceModel &m = head_1k().model;
   const Built &b = head_1k();
