@@ -1,5 +1,5 @@
 #!/bin/sh
-# Runs every gtest binary given as arguments, then the command-line tests in
+# Runs every gtest binary given as arguments and the command-line tests in
 # tests/cli/. AFM_BUILD names the build directory (tools in $AFM_BUILD/bin).
 #
 # AFM_TEST_JOBS tests run at once (default 2, the machine's cores): the suite
@@ -30,7 +30,7 @@ run="$AFM_BUILD/test-output/run-tests"
 rm -rf "$run"
 mkdir -p "$run"
 
-# The jobs: job.N holds the command. The longest start first, so that the
+# The jobs: name.N holds the test. The longest start first, so that the
 # lanes end together: these five take most of the time (under the
 # sanitizers, two at a time: 25, 22, 16, 14 and 1.3 min).
 slow="test_anatomy test_fap test_build.sh test_song.sh test_arm.sh"
@@ -40,11 +40,13 @@ for t in "$top"/tests/cli/*.sh; do [ -e "$t" ] && printf '%s\n' "$t" >>"$run/all
 n=0
 add() {
   n=$((n + 1))
-  case "$1" in
-    *.sh) printf 'sh "%s"\n' "$1" >"$run/job.$n" ;;
-    *) printf '"%s" --gtest_brief=1\n' "$1" >"$run/job.$n" ;;
-  esac
   printf '%s\n' "$1" >"$run/name.$n"
+}
+run_one() {
+  case "$1" in
+    *.sh) sh "$1" ;;
+    *) "$1" --gtest_brief=1 ;;
+  esac
 }
 for s in $slow; do
   while IFS= read -r t; do [ "$(basename "$t")" = "$s" ] && add "$t"; done <"$run/all"
@@ -59,13 +61,14 @@ lane() {
   i=1
   while [ "$i" -le "$n" ]; do
     if mkdir "$run/claim.$i" 2>/dev/null; then
+      name=$(cat "$run/name.$i")
       start=$(date +%s)
-      sh -c "$(cat "$run/job.$i")" >"$run/out.$i" 2>&1
+      run_one "$name" >"$run/out.$i" 2>&1
       rc=$?
       secs=$(($(date +%s) - start))
       echo "$rc" >"$run/rc.$i"
       until mkdir "$run/lock" 2>/dev/null; do sleep 1; done
-      echo "== $(cat "$run/name.$i") (${secs} s)"
+      echo "== $name (${secs} s)"
       cat "$run/out.$i"
       rmdir "$run/lock"
     fi

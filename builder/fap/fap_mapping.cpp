@@ -86,7 +86,7 @@ std::vector<FapMapping> make_table() {
   add(35, D::Muscles, 110, {{"frontalis_outer_left", 100}}, {{"frontalis_outer_left", -100}}, "");
   add(36, D::Muscles, 110, {{"frontalis_outer_right", 100}}, {{"frontalis_outer_right", -100}}, "");
   // Squeezing takes half the streams' 90th percentile: at 200 the inner brow
-  // would nearly reach the corrugator's attachment (docs/fap_mapping.md).
+  // would pass the corrugator's attachment (docs/fap_mapping.md).
   add(37, D::Muscles, 100, {{"corrugator_left", 100}}, {{"corrugator_left", -100}}, "");
   add(38, D::Muscles, 100, {{"corrugator_right", 100}}, {{"corrugator_right", -100}}, "");
   // ---- group 5: cheeks ----

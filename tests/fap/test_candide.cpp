@@ -122,7 +122,7 @@ TEST(Candide3, TargetsMoveTheWayCandidesFapBlocksDo) {
   ASSERT_TRUE(b);
   const FaceModel &m = b->model;
   // Every FAP, and no viseme or expression: Candide has no blocks for those,
-  // and they took most of this test's time (the jaw's large dynamic sets).
+  // so their solves (the jaw's large dynamic sets) were time spent for nothing.
   // The FAP targets are the same as in a whole build: only FAP targets split
   // the skin between them (fap_partition.h).
   FapSynthesisOptions so;
