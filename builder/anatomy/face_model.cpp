@@ -276,7 +276,7 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
   // each reads the model and writes only its own muscle, so they run on
   // `threads` workers and give the same result on any number of them.
   std::vector<size_t> todo;
-  for (size_t i = 0; i < model.muscles.size(); ++i)
+  for (size_t i = 0; options.calibrate_muscles && i < model.muscles.size(); ++i)
     if (options.calibrate_only.empty() ||
         std::find(options.calibrate_only.begin(), options.calibrate_only.end(), model.muscles[i].name) !=
             options.calibrate_only.end())

@@ -53,6 +53,7 @@ struct FaceModelOptions {
   // `calibrate_jaw`. Posing an uncalibrated muscle is an error. For tests and
   // tools that need a few muscles of a big model.
   std::vector<std::string> calibrate_only;
+  bool calibrate_muscles = true;  // off: no muscle, whatever calibrate_only says
   bool calibrate_jaw = true;
   // Workers for the calibration (muscles and the jaw are independent); 0: one
   // per core. The model is the same whatever the number.

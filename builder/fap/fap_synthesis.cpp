@@ -178,6 +178,33 @@ std::string high_level_label(const HighLevelMapping &h) {
 
 }  // namespace
 
+CalibrationNeeds calibration_needs(const FapSynthesisOptions &options) {
+  CalibrationNeeds need;
+  need.all = options.only.empty() && options.only_visemes.empty() && options.only_expressions.empty();
+  if (need.all) return need;
+  need.jaw = false;
+  auto add = [&need](const std::vector<FapContraction> &group) {
+    for (const FapContraction &c : group)
+      if (std::find(need.muscles.begin(), need.muscles.end(), c.muscle) == need.muscles.end())
+        need.muscles.push_back(c.muscle);
+  };
+  auto listed = [](const std::vector<int> &list, int n) {
+    return std::find(list.begin(), list.end(), n) != list.end();
+  };
+  for (const FapMapping &m : fap_mappings()) {
+    if (!listed(options.only, m.fap)) continue;
+    need.jaw |= m.driver == FapDriver::JawOpen || m.driver == FapDriver::JawThrust || m.driver == FapDriver::JawShift;
+    if (m.driver != FapDriver::Muscles) continue;
+    for (const auto *g : {&m.positive, &m.negative, &m.fallback_positive, &m.fallback_negative}) add(*g);
+  }
+  for (const HighLevelMapping &h : high_level_mappings()) {
+    if (!listed(h.expression ? options.only_expressions : options.only_visemes, h.number)) continue;
+    add(h.muscles);
+    need.jaw |= h.jaw_open > 0;
+  }
+  return need;
+}
+
 Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &model, const FapSynthesisOptions &options) {
   if (model.skin < 0 || model.tissue.n == 0) return Status::error("FAP synthesis: the model has no skin");
   const SkinModel &skin = model.tissue;

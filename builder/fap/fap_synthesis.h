@@ -119,6 +119,20 @@ struct FapSynthesisOptions {
   std::function<void(int done, int total, const std::string &what)> progress;
 };
 
+// What a synthesis with `options` poses, for a model built only for it
+// (FaceModelOptions::calibrate_muscles, calibrate_only, calibrate_jaw): the
+// muscles of every listed FAP's groups, both sides and their fallbacks, and
+// of every listed viseme and expression; the jaw for the jaw FAPs and a
+// viseme or expression that opens it. Each muscle calibrates on its own, so
+// the targets are the same as on a model with every muscle calibrated.
+// Nothing listed: every muscle and the jaw (`all`).
+struct CalibrationNeeds {
+  bool all = true;
+  std::vector<std::string> muscles;  // names, in table order of first use, once each
+  bool jaw = true;
+};
+CalibrationNeeds calibration_needs(const FapSynthesisOptions &options);
+
 struct FapSynthesis {
   // The made ones: FAPs in number order (positive side first), then the
   // visemes, then the expressions.

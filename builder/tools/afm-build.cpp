@@ -80,7 +80,10 @@ void usage(FILE *out) {
       "                          share of the muscles to blame that does not, and says so)\n"
       "  --profile P             draco (default: compressed) or raw\n"
       "  --faps LIST             only these targets: FAP numbers, vN visemes, eN\n"
-      "                          expressions, e.g. 3,12,31,v1,e1 (default: every mapped one)\n"
+      "                          expressions, e.g. 3,12,31,v1,e1 (default: every mapped one);\n"
+      "                          calibrates only the muscles they use (and those of\n"
+      "                          --contract and --influence), and the jaw when one opens\n"
+      "                          it or --jaw does: the targets are the same\n"
       "  --report DIR            with -o, also write the fidelity report into DIR:\n"
       "                          report.txt, report.csv, a picture per target\n"
       "                          (targets/*.png), a contact sheet (sheet.png) and\n"
@@ -288,6 +291,16 @@ int main(int argc, char **argv) {
   if (!out_path.empty() && !fo.calibrate) return usage_error("-o needs calibrated muscles (drop --no-calibrate)");
   if (!report_dir.empty() && out_path.empty()) return usage_error("--report needs -o");
 
+  // A subset of targets calibrates only what it poses (each muscle
+  // calibrates on its own: the targets are the same).
+  if (const CalibrationNeeds need = calibration_needs(so); !need.all && fo.calibrate) {
+    fo.calibrate_only = need.muscles;
+    for (const auto &c : contractions) fo.calibrate_only.push_back(c.first);
+    for (const auto &inf : influences) fo.calibrate_only.push_back(inf.first);
+    fo.calibrate_muscles = !fo.calibrate_only.empty();
+    fo.calibrate_jaw = need.jaw || jaw_open > 0;
+  }
+
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<std::string> log;
   Expected<LoadedFace> face = load_face(mesh_path, fdp_path, lo, &log);
@@ -332,10 +345,14 @@ int main(int argc, char **argv) {
   for (const std::string &n : model->notes) std::printf("note: %s\n", n.c_str());
   for (const std::string &w : model->warnings) std::printf("warning: %s\n", w.c_str());
   std::printf("%-26s %9s %8s %8s %11s %11s\n", "muscle", "length", "area", "V_d", "tension+", "tension-");
-  for (const Muscle &m : model->muscles)
-    std::printf("%-26s %9.4g %8zu %8zu %11.4g %11.4g\n", m.name.c_str(),
-                m.kind != MuscleKind::Sphincter ? m.length : m.semi_a, m.influence.size(), m.dynamic.size(),
-                m.tension_max, m.tension_min);
+  for (const Muscle &m : model->muscles) {
+    std::printf("%-26s %9.4g %8zu %8zu", m.name.c_str(), m.kind != MuscleKind::Sphincter ? m.length : m.semi_a,
+                m.influence.size(), m.dynamic.size());
+    if (m.tension_max > 0 || m.tension_min > 0)
+      std::printf(" %11.4g %11.4g\n", m.tension_max, m.tension_min);
+    else
+      std::printf(" %11s %11s\n", "-", "-");  // not calibrated (--no-calibrate, --faps)
+  }
   const Jaw &j = model->jaw;
   std::printf("jaw: %zu skin vertices (%zu ray hits, %d removed and %d added by the mouth-window search), "
               "V_d %zu, pivot (%.4g %.4g %.4g)\n",

@@ -29,6 +29,9 @@ grep -q "^12  *raise_l_cornerlip (negative)  *-150 " "$tmp/afm.txt" || fail "no 
 grep -q "^v10  *viseme A:  *63 " "$tmp/afm.txt" || fail "no report line for viseme A:"
 grep -q "^e1  *joy  *63 " "$tmp/afm.txt" || fail "no report line for joy"
 grep -q "^targets: 5 made, 0 not made" "$tmp/afm.txt" || fail "no summary: $(cat "$tmp/afm.txt")"
+# Only the muscles these targets pose are calibrated (the brows are not).
+grep -q "^zygomaticus_major_left .*[0-9]$" "$tmp/afm.txt" || fail "zygomaticus major left not calibrated"
+grep -q "^frontalis_inner_left .* - *-$" "$tmp/afm.txt" || fail "frontalis calibrated for targets that do not use it"
 r="$tmp/report"
 [ "$(grep -c -x -F -f "$r/report.txt" "$tmp/afm.txt")" -eq "$(wc -l <"$r/report.txt")" ] &&
   [ "$(wc -l <"$r/report.txt")" -eq 7 ] || fail "report.txt is not the printed table: $(cat "$r/report.txt")"

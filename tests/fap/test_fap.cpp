@@ -634,6 +634,42 @@ TEST(FapSynthesis, TheSameOnAnyNumberOfThreads) {
   for (size_t i = 0; i < one->jaw.controls.size(); ++i) EXPECT_EQ(one->jaw.controls[i].gain, three->jaw.controls[i].gain);
 }
 
+// afm-build --faps calibrates only what the listed targets pose
+// (calibration_needs). Each muscle calibrates on its own, so FAP 12's
+// targets on a model with only its two muscles calibrated, and no jaw, are
+// those of head_1k(), which also calibrates two other muscles and the jaw.
+TEST(FapSynthesis, AModelCalibratedOnlyForItsTargetsMakesTheSameTargets) {
+  FapSynthesisOptions o;
+  o.only = {12};
+  const CalibrationNeeds need = calibration_needs(o);
+  EXPECT_FALSE(need.all);
+  EXPECT_FALSE(need.jaw);
+  EXPECT_EQ(need.muscles, (std::vector<std::string>{"zygomaticus_major_left", "depressor_anguli_left"}));
+  FapSynthesisOptions jaw;
+  jaw.only_visemes = {10};  // A opens the jaw
+  EXPECT_TRUE(calibration_needs(jaw).jaw);
+  EXPECT_TRUE(calibration_needs(FapSynthesisOptions{}).all);
+
+  FaceModelOptions fo;
+  fo.calibrate_only = need.muscles;
+  fo.calibrate_jaw = need.jaw;
+  const std::unique_ptr<Built> b = afmtest::build_reference_model(1000, fo);
+  ASSERT_TRUE(b);
+  EXPECT_EQ(b->model.muscles[static_cast<size_t>(b->model.find("frontalis_major_left"))].tension_max, 0)
+      << "calibrated though FAP 12 does not use it";
+  Expected<FapSynthesis> s = synthesize_faps(b->head.scene, b->model, o);
+  ASSERT_TRUE(s.is_ok()) << s.status().message();
+  int compared = 0;
+  for (const MorphTarget &t : s->targets) {
+    const MorphTarget *all = target(12, t.reference > 0 ? +1 : -1);
+    ASSERT_NE(all, nullptr);
+    const size_t skin = static_cast<size_t>(b->model.skin);
+    EXPECT_EQ(t.displacement[skin], all->displacement[skin]) << "bit for bit, side " << t.reference;
+    ++compared;
+  }
+  EXPECT_EQ(compared, 2);
+}
+
 using DocPtr = std::unique_ptr<afm_doc, void (*)(afm_doc *)>;
 
 // The content encoded (draco profile) and read back; null, with a test
