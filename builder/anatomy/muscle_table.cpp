@@ -28,6 +28,10 @@ using K = MuscleKind;
 //    area. Anatomically it rises from the bone at the brows' inner ends and
 //    inserts in the mid-brow skin: attachment a third of the way from 4.1
 //    to 4.2, insertion 4.3.
+//  - mentalis: the paper's attachment 2.1 + (2.1 - m) mirrors a point through
+//    the chin in depth too, in front of the face on Song, whose two short
+//    fibres then missed the lower lip's middle. From the chin straight below
+//    its insertion here, pushing the lip up, wider and with a larger range.
 const std::vector<MuscleDef> kTable = {
     {"frontalis_inner_left", K::Linear, "11.1 + 1/6 (11.3 - 11.1)", "4.1", nullptr, 0.30, +1, 0.18, 0.06, false, false, false},
     {"frontalis_inner_right", K::Linear, "11.1 + 1/6 (11.2 - 11.1)", "4.2", nullptr, 0.30, +1, 0.18, 0.06, false, false, false},
@@ -49,8 +53,8 @@ const std::vector<MuscleDef> kTable = {
     {"risorius_right", K::Linear, "5.2", "8.4", nullptr, 0.25, +1, 0.20, 0.06, false, true, true},
     {"depressor_anguli_left", K::Linear, "8.3 + (8.3 - 9.1)", "8.3", nullptr, 0.35, +1, 0.30, 0.10, false, false, true},
     {"depressor_anguli_right", K::Linear, "8.4 + (8.4 - 9.2)", "8.4", nullptr, 0.35, +1, 0.30, 0.10, false, false, true},
-    {"mentalis_left", K::Linear, "2.1 + (2.1 - (8.4 + (8.4 - 9.2)))", "2.8", nullptr, 0.35, -1, 0.08, 0.06, false, false, true},
-    {"mentalis_right", K::Linear, "2.1 + (2.1 - (8.3 + (8.3 - 9.1)))", "2.9", nullptr, 0.35, -1, 0.08, 0.06, false, false, true},
+    {"mentalis_left", K::Linear, "2.10 + (2.8 - 2.3)", "2.8", nullptr, 0.45, -1, 0.12, 0.08, false, false, true},
+    {"mentalis_right", K::Linear, "2.10 + (2.9 - 2.3)", "2.9", nullptr, 0.45, -1, 0.12, 0.08, false, false, true},
     {"orbicularis_oculi_left", K::Sphincter, "3.7", "3.9", "3.5", 1.8, +1, 0.50, 0.20, true, false, false},
     {"orbicularis_oculi_right", K::Sphincter, "3.12", "3.10", "3.6", 1.8, +1, 0.50, 0.20, true, false, false},
     {"orbicularis_oris", K::Sphincter, "8.3", "8.2", "1/2 (8.1 + 8.2)", 1.6, +1, 0.25, 0.10, false, true, true},

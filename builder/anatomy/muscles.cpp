@@ -140,6 +140,23 @@ Status place_lid(const SkinModel &skin, const Eigen::Vector3d &outer, const Eige
   return Status::ok();
 }
 
+// The node of `layer` a key point maps to: the nearest (section 3.2), except
+// that a key point that is one FDP keeps the FDP's own vertex among vertices
+// at the same place. A closed mouth's lip line has two vertices at each
+// point, one per lip (the generated heads): by index order mentalis' insertion
+// 2.8 went to the upper lip's vertex, 2.6's, and its calibration measured the
+// upper lip.
+int key_node(const SkinModel &skin, const FdpSet &fdps, int layer, const Keypoint &k, const Eigen::Vector3d &p) {
+  const int best = nearest_node(skin, layer, p);
+  if (best < 0 || k.terms.size() != 1 || k.terms[0].second != 1) return best;
+  const FdpPoint *f = fdps.find(k.terms[0].first, skin.part);
+  if (!f || f->vertex < 0 || f->vertex >= skin.n || !skin.in_mesh[static_cast<size_t>(f->vertex)]) return best;
+  const int v = best % skin.n;
+  const bool same_place = skin.X0.row(skin.node(kEpidermis, v)) == skin.X0.row(skin.node(kEpidermis, f->vertex)) &&
+                          skin.X0.row(best) == skin.X0.row(skin.node(layer, f->vertex));
+  return same_place ? skin.node(layer, f->vertex) : best;
+}
+
 }  // namespace
 
 Expected<Muscle> place_muscle(const SkinModel &skin, const FdpSet &fdps, int def) {
@@ -166,8 +183,8 @@ Expected<Muscle> place_muscle(const SkinModel &skin, const FdpSet &fdps, int def
 
   if (d.kind == MuscleKind::Linear) {
     m.force_layer = kDermis;
-    m.node_a = nearest_node(skin, kSkull, m.key_a);
-    m.node_b = nearest_node(skin, kDermis, m.key_b);
+    m.node_a = key_node(skin, fdps, kSkull, keys[0], m.key_a);
+    m.node_b = key_node(skin, fdps, kDermis, keys[1], m.key_b);
     const Eigen::Vector3d a = skin.X0.row(m.node_a), b = skin.X0.row(m.node_b);
     m.length = (b - a).norm();
     if (!(m.length > 0))
@@ -193,8 +210,8 @@ Expected<Muscle> place_muscle(const SkinModel &skin, const FdpSet &fdps, int def
   } else {
     m.force_layer = kHypodermis;
     m.epicentre = eval_keypoint(keys[2], fdps);
-    m.node_a = nearest_node(skin, kHypodermis, m.key_a);
-    m.node_b = nearest_node(skin, kHypodermis, m.key_b);
+    m.node_a = key_node(skin, fdps, kHypodermis, keys[0], m.key_a);
+    m.node_b = key_node(skin, fdps, kHypodermis, keys[1], m.key_b);
     m.semi_a = std::abs(skin.X0(m.node_a, 0) - m.epicentre.x());
     m.semi_b = std::abs(skin.X0(m.node_b, 1) - m.epicentre.y());
     if (!(m.semi_a > 0) || !(m.semi_b > 0))

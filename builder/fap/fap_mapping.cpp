@@ -115,10 +115,8 @@ std::vector<FapMapping> make_table() {
 // Visemes and expressions. Muscles by pair name ("zygomaticus_major" is
 // both sides); the signs as above: a negative upper lip raises the upper
 // lip, a negative orbicularis oculi widens the eye. Jaw openings in FAP 3
-// units (the table's reference, wide open, is 320). Mentalis stays at a
-// few percent: its calibrated range is its key node's alone (8 % of its
-// fibre), and both sides together lift the free lower lip several times
-// further (FAP 5 needs 6 % of both for 350 units on the 2k head).
+// units (the table's reference, wide open, is 320). Mentalis, the chin
+// raiser (AU 17), presses the lower lip up.
 std::vector<HighLevelMapping> make_high_level_table() {
   std::vector<HighLevelMapping> t;
   struct Pair {
@@ -140,8 +138,8 @@ std::vector<HighLevelMapping> make_high_level_table() {
     t.push_back(std::move(m));
   };
   // ---- visemes (ISO/IEC 14496-2 Table C-1) ----
-  add(false, 1, 0, {{"orbicularis_oris", 50}, {"mentalis", 5}}, "lips pressed together");
-  add(false, 2, 60, {{"mentalis", 6}, {"upper_lip", -30}}, "lower lip up against the upper teeth");
+  add(false, 1, 0, {{"orbicularis_oris", 50}, {"mentalis", 40}}, "lips pressed together");
+  add(false, 2, 60, {{"mentalis", 60}, {"upper_lip", -30}}, "lower lip up against the upper teeth");
   add(false, 3, 100, {}, "jaw a little open, tongue between the teeth");
   add(false, 4, 90, {}, "jaw a little open");
   add(false, 5, 130, {}, "jaw half open");
@@ -159,16 +157,16 @@ std::vector<HighLevelMapping> make_high_level_table() {
       {{"zygomaticus_major", 100}, {"zygomaticus_minor", 50}, {"risorius", 20}, {"orbicularis_oculi", 40}},
       "joy: corners up and back, cheeks raised, eyes narrowed");
   add(true, 2, 0,
-      {{"frontalis_inner", 80}, {"corrugator", 50}, {"depressor_anguli", 100}, {"mentalis", 4}},
+      {{"frontalis_inner", 80}, {"corrugator", 50}, {"depressor_anguli", 100}, {"mentalis", 50}},
       "sadness: inner brows up and together, corners down, chin raised");
-  add(true, 3, 0, {{"corrugator", 100}, {"orbicularis_oculi", 40}, {"orbicularis_oris", 50}, {"mentalis", 3}},
+  add(true, 3, 0, {{"corrugator", 100}, {"orbicularis_oculi", 40}, {"orbicularis_oris", 50}, {"mentalis", 40}},
       "anger: brows down and together, eyes narrowed, lips pressed");
   add(true, 4, 80,
       {{"frontalis_inner", 100}, {"frontalis_major", 50}, {"corrugator", 40}, {"risorius", 70},
        {"orbicularis_oculi", -50}},
       "fear: brows up and together, eyes wide, lips stretched, jaw dropped");
   add(true, 5, 0,
-      {{"upper_lip", -100}, {"nasalis", 60}, {"corrugator", 40}, {"depressor_anguli", 30}, {"mentalis", 5}},
+      {{"upper_lip", -100}, {"nasalis", 60}, {"corrugator", 40}, {"depressor_anguli", 30}, {"mentalis", 30}},
       "disgust: upper lip raised, nose wrinkled, brows lowered");
   add(true, 6, 220,
       {{"frontalis_inner", 100}, {"frontalis_major", 100}, {"frontalis_outer", 100}, {"orbicularis_oculi", -60}},
