@@ -98,7 +98,9 @@ struct Muscle {
 };
 
 // Places one muscle of the table: evaluates its key points, maps them to the
-// nearest node of the proper layer and computes its influence area. Fails
+// nearest node of the proper layer (a key point that is one FDP to the FDP's
+// own vertex where several lie at that place, as on a closed mouth's lip
+// line) and computes its influence area. Fails
 // naming the FDPs when some are missing from `fdps`.
 Expected<Muscle> place_muscle(const SkinModel &skin, const FdpSet &fdps, int def);
 

@@ -24,8 +24,11 @@
 #include <utility>
 
 #include "anatomy/fdp_completion.h"
+#include "anatomy/muscle_table.h"
+#include "anatomy/muscles.h"
 #include "anatomy/skin_model.h"
 #include "core/part_kind.h"
+#include "core/validate.h"
 
 namespace afmb {
 
@@ -298,6 +301,8 @@ Expected<SimMesh> make_sim_mesh(const Scene &scene, const FdpSet &fdps, const Si
     if (is_feature(p.id)) features.push_back(p.pos);
     if (is_lip(p.id)) lips.push_back(p.pos);
   }
+  for (int v : options.keep)
+    if (v >= 0 && v < n) locked[static_cast<size_t>(v)] = 1;
   // Without both pupils, a tenth of the skin's diagonal stands in for the
   // eye separation.
   Eigen::Vector3d lo = skin.V.colwise().minCoeff(), hi = skin.V.colwise().maxCoeff();
@@ -460,6 +465,27 @@ FdpSet lift_fdps(const FdpSet &coarse, const SimMesh &sim) {
   return out;
 }
 
+Expected<std::vector<int>> muscle_key_vertices(const Scene &scene, const FdpSet &fdps, const TissueParams &tissue) {
+  const int skin = scene.find_kind(PartKind::Skin);
+  if (skin < 0) return Status::error("no skin part: no part holds FDP 2.1 (chin)");
+  if (Status s = check_skin(scene, skin); !s) return s;
+  Expected<SkinModel> t = build_skin_model(scene, skin, tissue);
+  if (!t) return t.status();
+  std::vector<int> out;
+  auto add = [&](int node) {
+    if (node < 0) return;
+    const int v = t->vertex_of(node);
+    if (std::find(out.begin(), out.end(), v) == out.end()) out.push_back(v);
+  };
+  for (size_t d = 0; d < muscle_table().size(); ++d) {
+    Expected<Muscle> m = place_muscle(*t, fdps, static_cast<int>(d));
+    if (!m) continue;  // build_face_model says why
+    add(m->node_a);
+    add(m->node_b);
+  }
+  return out;
+}
+
 Expected<SimFaceModel> build_sim_face_model(const Scene &scene, const FdpSet &fdps, SimMeshOptions sim_options,
                                             const FaceModelOptions &options,
                                             const std::function<void(const SimMesh &)> &on_mesh) {
@@ -475,6 +501,11 @@ Expected<SimFaceModel> build_sim_face_model(const Scene &scene, const FdpSet &fd
       if (!added) return added.status();
     }
   }
+  // (A skin they cannot be placed on fails build_face_model below, which
+  // says why.)
+  if (sim_options.vertices > 0)
+    if (Expected<std::vector<int>> keys = muscle_key_vertices(scene, complete, options.tissue); keys)
+      sim_options.keep.insert(sim_options.keep.end(), keys->begin(), keys->end());
   for (;;) {
     Expected<SimMesh> sim = make_sim_mesh(scene, complete, sim_options);
     if (!sim) return sim.status();

@@ -61,6 +61,9 @@ struct SimMeshOptions {
   // many vertices: no decimation (the simulation mesh is the skin). The
   // decimation stops earlier when no legal collapse is left.
   int vertices = 0;
+  // Skin vertices to keep besides the FDPs' (with their mirror images on a
+  // mirror-symmetric skin), e.g. muscle_key_vertices().
+  std::vector<int> keep = {};  // (an initializer: SimMeshOptions{N} stays warning-free)
 };
 
 struct SimMesh {
@@ -92,6 +95,17 @@ FdpSet lift_fdps(const FdpSet &coarse, const SimMesh &sim);
 // The skin displacement (#V x 3) carried from a coarse one (#Vc x 3).
 Eigen::MatrixXd lift_displacement(const SimMesh &sim, const Eigen::MatrixXd &Dc);
 
+// The skin vertices whose nodes the muscles' key points map to on the skin
+// itself (muscles.h: attachments to the skull layer, insertions to the
+// dermis, sphincters' ends to the hypodermis), built with `tissue`; in
+// table order, once each. Kept by the simulation mesh, the key points map
+// as on the skin: a key point inside the tissue (depressor anguli's lies 5.6
+// units under Song's skin) is otherwise near several coarse nodes, and which
+// one is nearest differed from side to side on Song's simulation mesh.
+// Fails on no skin part, one that check_skin() refuses, or a tissue that
+// cannot be built; muscles lacking FDPs are left out.
+Expected<std::vector<int>> muscle_key_vertices(const Scene &scene, const FdpSet &fdps, const TissueParams &tissue);
+
 // The face model built on a simulation mesh, as afm-build makes it.
 struct SimFaceModel {
   SimMesh sim;
@@ -102,7 +116,8 @@ struct SimFaceModel {
 };
 
 // The missing FDPs estimated on the skin (when options.estimate_missing_fdps;
-// the decimation keeps them), make_sim_mesh, then build_face_model on it. A
+// the decimation keeps them), make_sim_mesh keeping muscle_key_vertices()
+// too, then build_face_model on it. A
 // decimated mesh on which the model does not build (a coarse tissue that
 // cannot calibrate an essential muscle) is made again 1.5 times as fine, up
 // to the skin itself, whose failure is returned. `on_mesh`, when given, is
