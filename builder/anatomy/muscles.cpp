@@ -151,7 +151,7 @@ int key_node(const SkinModel &skin, const FdpSet &fdps, int layer, const Keypoin
   if (best < 0 || k.terms.size() != 1 || k.terms[0].second != 1) return best;
   const FdpPoint *f = fdps.find(k.terms[0].first, skin.part);
   if (!f || f->vertex < 0 || f->vertex >= skin.n || !skin.in_mesh[static_cast<size_t>(f->vertex)]) return best;
-  const int v = best % skin.n;
+  const int v = skin.vertex_of(best);
   const bool same_place = skin.X0.row(skin.node(kEpidermis, v)) == skin.X0.row(skin.node(kEpidermis, f->vertex)) &&
                           skin.X0.row(best) == skin.X0.row(skin.node(layer, f->vertex));
   return same_place ? skin.node(layer, f->vertex) : best;

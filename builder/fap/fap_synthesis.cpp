@@ -176,20 +176,24 @@ std::string high_level_label(const HighLevelMapping &h) {
                       : "viseme " + std::string(afm_viseme_phonemes(h.number));
 }
 
+bool listed(const std::vector<int> &list, int n) { return std::find(list.begin(), list.end(), n) != list.end(); }
+
+// Nothing listed in `options`: every FAP, viseme and expression is made.
+bool lists_nothing(const FapSynthesisOptions &options) {
+  return options.only.empty() && options.only_visemes.empty() && options.only_expressions.empty();
+}
+
 }  // namespace
 
 CalibrationNeeds calibration_needs(const FapSynthesisOptions &options) {
   CalibrationNeeds need;
-  need.all = options.only.empty() && options.only_visemes.empty() && options.only_expressions.empty();
+  need.all = lists_nothing(options);
   if (need.all) return need;
   need.jaw = false;
   auto add = [&need](const std::vector<FapContraction> &group) {
     for (const FapContraction &c : group)
       if (std::find(need.muscles.begin(), need.muscles.end(), c.muscle) == need.muscles.end())
         need.muscles.push_back(c.muscle);
-  };
-  auto listed = [](const std::vector<int> &list, int n) {
-    return std::find(list.begin(), list.end(), n) != list.end();
   };
   for (const FapMapping &m : fap_mappings()) {
     if (!listed(options.only, m.fap)) continue;
@@ -219,10 +223,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     int reference = 0;        // FAP units along `side` (> 0)
     bool in_between = false;  // one of the mapping's `farther`
   };
-  auto listed = [](const std::vector<int> &list, int n) {
-    return std::find(list.begin(), list.end(), n) != list.end();
-  };
-  const bool everything = options.only.empty() && options.only_visemes.empty() && options.only_expressions.empty();
+  const bool everything = lists_nothing(options);
   std::vector<Work> work;
   for (const FapMapping &m : fap_mappings()) {
     if (m.driver == FapDriver::Rigid || m.driver == FapDriver::None) continue;
