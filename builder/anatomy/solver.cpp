@@ -776,6 +776,9 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
   };
   const int max_it = options.max_iterations > 0 ? options.max_iterations : 400;
   double action = 0;
+  constexpr int kStall = 60;
+  double best_distance = 0;
+  int best_at = 0;
   int projected_run = 0;  // refreshes in a row that did not factorise the full tangent
   double shift = 1e-3;    // the last diagonal shift that made the full tangent definite
   for (int it = 0;; ++it) {
@@ -796,6 +799,20 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     }
     const bool on_target = !control || control->capped || std::abs(action - control->value) < tol;
     if (it > 0 && st.residual < tol && st.last_step < tol && on_target) break;
+    // Stall: the distance to the solution (the remaining displacement, and
+    // the action's from its value) has not halved its best for kStall
+    // iterations. Newton then cycles (a lid turned 50 degrees: the line
+    // search cuts to 1/2048, a fresh tangent leaps back, for all 400
+    // iterations); a converging solve halves it every few.
+    const double distance = st.residual + (control && !control->capped ? std::abs(action - control->value) : 0.0);
+    if (it == 0 || distance < 0.5 * best_distance) best_distance = distance, best_at = it;
+    if (it - best_at >= kStall) {
+      st.contacts = contacts.active;
+      std::string why = name + ": no equilibrium, no progress in " + std::to_string(kStall) +
+                        " iterations (remaining displacement " + number(st.residual);
+      if (control) why += ", action " + number(action) + " of " + number(control->value);
+      return done(false, why + ")");
+    }
     if (it >= max_it) {
       st.contacts = contacts.active;
       std::string why = name + ": no equilibrium after " + std::to_string(max_it) +

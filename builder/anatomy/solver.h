@@ -82,8 +82,13 @@
 //   the remaining displacement, max over unknowns |r_i| / K_ii (residual
 //   force over the diagonal stiffness), is below tol.
 // A solve that does not meet it within max_iterations, or meets a non-finite
-// number, fails: `converged` is false, X holds the last finite iterate and
-// `message` says why. Nothing in it is NaN.
+// number, fails; so does a newton solve whose remaining displacement has not
+// fallen below half its best for 60 iterations (it cycles: the generated
+// heads' upper lids at their table turn; the converging solves of three
+// heads' whole AFMs halve it every few iterations, and the AFMs are
+// byte-identical with the rule and without). On failure `converged` is
+// false, X holds the last finite iterate and `message` says why. Nothing in
+// it is NaN.
 #pragma once
 
 #include <Eigen/Core>
