@@ -944,6 +944,40 @@ TEST(FdpCompletion, EstimatesLandNearTheTrueFdps) {
   }
 }
 
+// The frozen template (fdp_completion.cpp) is the reference head's FDPs:
+// every surface FDP once, mirror-symmetric, and near the generator's own at
+// two resolutions. The generator's FDPs snap to its nearest vertex, so they
+// move with the mesh: by up to 13 mm between 1000 and 10000 vertices. Bound:
+// a quarter of ES0 (63 mm on the reference head).
+TEST(FdpCompletion, TheTemplateIsTheReferenceHeads) {
+  const auto tpl = fdp_template();
+  EXPECT_EQ(tpl.size(), 82u);
+  int mirrored = 0;
+  for (const auto &a : tpl)
+    for (const auto &b : tpl) {
+      if (a.first == b.first || std::abs(a.second.x()) < 1e-6 || a.second.x() < 0) continue;
+      const Eigen::Vector3d m(-b.second.x(), b.second.y(), b.second.z());
+      if ((a.second - m).norm() < 2e-6) ++mirrored;
+    }
+  EXPECT_GE(mirrored, 30) << "left/right pairs that mirror each other to the micrometre";
+  for (int n : {1000, 10000}) {
+    RefHeadOptions o;
+    o.skin_vertices = n;
+    Expected<RefHead> h = make_reference_head(o);
+    ASSERT_TRUE(h.is_ok());
+    double worst = 0;
+    std::string at;
+    for (const auto &t : tpl) {
+      const FdpPoint *p = h->fdps.find(t.first);
+      ASSERT_NE(p, nullptr) << t.first.str();
+      const double d = (p->pos - t.second).norm();
+      if (d > worst) worst = d, at = t.first.str();
+    }
+    std::printf("template against the %d-vertex head: worst %.2f mm (FDP %s)\n", n, worst * 1e3, at.c_str());
+    EXPECT_LT(worst, 0.25 * 0.063) << n << " vertices, FDP " << at;
+  }
+}
+
 // Song's own skin FDPs, each left out in turn and estimated: the local fit
 // lands 3.5 model units (0.107 ES0) from the truth on average; a global
 // affine fit, 4.6 (0.14 ES0). Bound: 0.12 ES0.
