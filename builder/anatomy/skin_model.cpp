@@ -288,7 +288,12 @@ Expected<SkinModel> build_skin_model(const Scene &scene, int part, const TissueP
     if (const int8_t e = m.eye_near[static_cast<size_t>(v)]; e >= 0) {
       const EyeSphere &ball = m.eyes[static_cast<size_t>(e)];
       const double rest = (p.V.row(v).transpose() - ball.centre).norm() - ball.radius;
-      m.eye_clearance[static_cast<size_t>(v)] = std::clamp(rest, 0.0, kEyeClearance * ball.radius);
+      // The skin between two held nodes is a chord: held at least its dip
+      // l^2 / (8 r) off, the longest edge's chord stays outside the ball.
+      double dip = 0;
+      for (int u : m.neighbours[static_cast<size_t>(v)])
+        dip = std::max(dip, (p.V.row(v) - p.V.row(u)).squaredNorm() / (8.0 * ball.radius));
+      m.eye_clearance[static_cast<size_t>(v)] = std::clamp(rest, 0.0, std::max(kEyeClearance * ball.radius, dip));
     }
   }
   return m;

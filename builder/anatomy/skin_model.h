@@ -137,9 +137,10 @@ struct SkinModel {
   // eyeball keeps its skull plane until it meets the sphere.
   std::vector<int8_t> eye_near;
   // Per vertex: how far off its eyeball's sphere the epidermal node is held
-  // (model units): its distance at rest, up to kEyeClearance radii. On the
-  // sphere itself the skin between nodes, a chord, and the eye part's
-  // vertices cross: Song's eyeball showed through the lid as dark specks.
+  // (model units): its distance at rest, up to kEyeClearance radii or its
+  // longest edge's chord dip l^2 / (8 r), whichever is more. On the sphere
+  // itself the skin between nodes, a chord, and the eye part's vertices
+  // cross: Song's eyeball showed through the lid as dark specks.
   std::vector<double> eye_clearance;
 
   int node(int layer, int vertex) const { return layer * n + vertex; }

@@ -116,6 +116,26 @@ double deepest_in_eyes(const FaceModel &m, const Eigen::MatrixXd &X) {
   return d;
 }
 
+// How far the skin between two epidermal nodes near an eyeball (an edge's
+// midpoint) goes into it (model units; negative: it stays outside).
+double deepest_chord_in_eyes(const FaceModel &m, const Eigen::MatrixXd &X) {
+  double d = -1;
+  for (const EyeSphere &s : m.tissue.eyes)
+    for (int f = 0; f < m.tissue.F.rows(); ++f)
+      for (int k = 0; k < 3; ++k) {
+        const int a = m.tissue.F(f, k), b = m.tissue.F(f, (k + 1) % 3);
+        bool near = true;
+        for (int v : {a, b}) {
+          const double rest = (m.tissue.X0.row(v).transpose() - s.centre).norm();
+          near = near && rest >= s.radius && rest <= 1.5 * s.radius;
+        }
+        if (!near) continue;
+        const Eigen::Vector3d mid = 0.5 * (X.row(a) + X.row(b)).transpose();
+        d = std::max(d, s.radius - (mid - s.centre).norm());
+      }
+  return d;
+}
+
 // Every element keeps the sign of each of its tetrahedra.
 // Tetrahedra seen nearly edge-on from the centre (under a thousandth of the
 // mean volume) are not judged: their sign says nothing.
@@ -463,6 +483,24 @@ TEST(Physics, TheLidsSlideOverTheEyeball) {
   EXPECT_LT(moved(m, X, "3.1").y(), -1e-3) << "the upper lid comes down";
   EXPECT_LE(deepest(X), 1e-9) << "no lid enters its eyeball";
   EXPECT_TRUE(X.allFinite());
+  // The skin between its nodes: each is held at least its longest edge's
+  // chord dip off the ball, up to its rest distance. On the 1k head's coarse
+  // lid that keeps the edges' midpoints 1.2 mm into the ball instead of 2.1
+  // mm held 0.01 r off (0.46 mm at rest: edges at the margin already cut
+  // it; the nodes there are held at most at their rest distance).
+  FaceModel thin = m;
+  for (int v = 0; v < thin.tissue.n; ++v)
+    if (const int e = thin.tissue.eye_near[static_cast<size_t>(v)]; e >= 0) {
+      const EyeSphere &ball = thin.tissue.eyes[static_cast<size_t>(e)];
+      const double rest = (thin.tissue.X0.row(v).transpose() - ball.centre).norm() - ball.radius;
+      thin.tissue.eye_clearance[static_cast<size_t>(v)] = std::clamp(rest, 0.0, kEyeClearance * ball.radius);
+    }
+  const Eigen::MatrixXd T = contract(thin, "orbicularis_oculi_left", t);
+  std::printf("1k head, orbicularis oculi at tension %g: the lid's edges %.3f mm into the eyeball held at the chord "
+              "dip, %.3f mm held at 0.01 r, %.3f mm at rest\n",
+              t, 1e3 * deepest_chord_in_eyes(m, X), 1e3 * deepest_chord_in_eyes(thin, T),
+              1e3 * deepest_chord_in_eyes(m, m.tissue.X0));
+  EXPECT_LT(deepest_chord_in_eyes(m, X), 0.7 * deepest_chord_in_eyes(thin, T)) << "the lid's edges held farther out";
 
   FaceModel free = m;  // the same model without the eyeballs
   free.tissue.eyes.clear();
@@ -585,7 +623,11 @@ TEST(Physics, PosesStartedFromTheCalibratedPosesAddedAreTheSameEquilibria) {
   const int zyg = m->find("zygomaticus_major_left"), ris = m->find("risorius_left");
   FactorCache cache;
   // One muscle at +100 %, or the jaw fully open: the guess is the
-  // calibrated pose, already in equilibrium.
+  // calibrated pose, already in equilibrium. A few iterations find its
+  // eyeball contacts again: a lid node held at its clearance lies on that
+  // sphere only to rounding, and is free until a step pushes it in (3
+  // iterations since lid nodes are held up to their rest distance, 1
+  // before).
   Activation one, open;
   one.muscles = {{zyg, 100.0}};
   open.jaw_open = 100;
@@ -595,7 +637,7 @@ TEST(Physics, PosesStartedFromTheCalibratedPosesAddedAreTheSameEquilibria) {
     po.start = &alone;
     Expected<Pose> settled = solve_pose(*m, a, &cache, po);
     ASSERT_TRUE(settled.is_ok()) << settled.status().message();
-    EXPECT_LE(settled->stats.iterations, 1);
+    EXPECT_LE(settled->stats.iterations, 3) << "jaw " << a.jaw_open;
     EXPECT_LE((settled->X - alone.X).cwiseAbs().maxCoeff(), m->quantum);
   }
   // Both at 70 % and -60 %, and both at 50 % with the jaw open 40 %: the same
@@ -633,7 +675,8 @@ TEST(Physics, ResidualBelowToleranceAtTheEnd) {
   const Eigen::MatrixXd X = contract(m, "zygomaticus_major_left", 0.05, &st);
   EXPECT_LT(st.residual, m.solver.tolerance);
   // Independently: the net force on every free node is tiny next to the
-  // muscle's largest nodal force (skull contacts take their normal part).
+  // muscle's largest nodal force (skull and eyeball contacts take their
+  // normal part; a lid node may be held at its rest distance from the ball).
   Eigen::MatrixXd load = Eigen::MatrixXd::Zero(X.rows(), 3);
   muscle_load(m.tissue, mu, 0.05, X, &load);
   const Eigen::MatrixXd r = residual_forces(m.tissue, all_vertices(m.tissue), f, m.tissue.X0, X);
@@ -644,6 +687,12 @@ TEST(Physics, ResidualBelowToleranceAtTheEnd) {
     const Eigen::Vector3d n = m.tissue.normal.row(v);
     const double gap = (X.row(g) - X.row(m.tissue.node(kSkull, v))).dot(n);
     if (skull_rejects(m.tissue, v) && gap < 1e-9) rg -= n * std::min(0.0, rg.dot(n));
+    if (const int e = m.tissue.eye_near[static_cast<size_t>(v)]; e >= 0 && g == m.tissue.node(kEpidermis, v)) {
+      const EyeSphere &ball = m.tissue.eyes[static_cast<size_t>(e)];
+      const Eigen::Vector3d q = X.row(g).transpose() - ball.centre;
+      if (q.norm() - ball.radius - m.tissue.eye_clearance[static_cast<size_t>(v)] < 1e-9)
+        rg -= q.normalized() * std::min(0.0, rg.dot(q.normalized()));
+    }
     worst = std::max(worst, rg.norm());
   }
   EXPECT_LT(worst, 1e-3 * load.rowwise().norm().maxCoeff());
