@@ -997,7 +997,7 @@ TEST(FdpCompletion, EstimatesLandNearTheTrueFdps) {
 // every surface FDP once, mirror-symmetric, and near the generator's own at
 // two resolutions. The generator's FDPs snap to its nearest vertex, so they
 // move with the mesh: by up to 13 mm between 1000 and 10000 vertices. Bound:
-// a quarter of ES0 (63 mm on the reference head).
+// a quarter of ES0, which is 63 mm on the reference head (so 15.75 mm).
 TEST(FdpCompletion, TheTemplateIsTheReferenceHeads) {
   const auto tpl = fdp_template();
   EXPECT_EQ(tpl.size(), 82u);
