@@ -574,9 +574,20 @@ TEST(Physics, TheJawOpens) {
   EXPECT_LT(moved(m, p->X, "9.3").norm(), 0.1e-3) << "the nose stays";
   EXPECT_TRUE(p->X.allFinite());
   EXPECT_EQ(penetrating_nodes(m.tissue, p->X, 1e-9), 0);
-  // The mouth-window search adds the lower lip, not the chin's underside.
+  // The jaw holds the lower lip (the mouth-window search adds what the rays
+  // miss), not the upper lip (it removes what they hit) nor the chin's
+  // underside.
   EXPECT_GT(m.jaw.added, 0);
+  Expected<MouthLips> lips = mouth_lips(m.tissue, m.fdps);
+  ASSERT_TRUE(lips.is_ok()) << lips.status().message();
   const double chin_bottom = m.fdps.find(*FdpId::parse("2.1"))->pos.y();
+  auto on_jaw = [&](int v) { return std::binary_search(m.jaw.vertices.begin(), m.jaw.vertices.end(), v); };
+  ASSERT_FALSE(lips->lower.empty());
+  for (int v : lips->lower)
+    if (m.tissue.X0(v, 1) >= chin_bottom) EXPECT_TRUE(on_jaw(v)) << "lower-lip vertex " << v;
+  for (int v : lips->upper) EXPECT_FALSE(on_jaw(v)) << "upper-lip vertex " << v;
+  std::printf("jaw: %zu vertices, %zu ray hits, %d removed, %d added\n", m.jaw.vertices.size(), m.jaw.ray_hits.size(),
+              m.jaw.removed, m.jaw.added);
   for (int v : m.jaw.vertices) {
     if (!std::binary_search(m.jaw.ray_hits.begin(), m.jaw.ray_hits.end(), v)) {
       EXPECT_GE(m.tissue.X0(v, 1), chin_bottom) << "vertex " << v << " added below the chin";
@@ -712,7 +723,7 @@ TEST(Physics, InvariantUnderTranslationAndScalesWithTheHead) {
     fo.calibrate = false;
     Expected<FaceModel> m = build_face_model(s, f, fo);
     EXPECT_TRUE(m.is_ok()) << m.status().message();
-    const Eigen::MatrixXd X = contract(*m, "zygomaticus_major_left", 0.05);
+    const Eigen::MatrixXd X = contract(*m, "zygomaticus_major_left", 0.06);
     return Eigen::MatrixXd(X.topRows(m->tissue.n) - m->tissue.X0.topRows(m->tissue.n));
   };
   const Eigen::MatrixXd base = displacement(Eigen::Vector3d::Zero(), 1.0);
@@ -831,18 +842,22 @@ Pose expect_calibrated_to_a_part(const FaceModel &m, const std::string &name, co
 // table's range calibrates to the part the tissue allows (a half, a
 // quarter or an eighth), says so, and +100 % then meets that part. Here the
 // 1k head's tissue stiffens a thousandfold beyond 3 % strain, and frontalis
-// gets half its range. (This was Song's eye sphincter on its whole skin, a
+// outer gets a part of its range. (Frontalis major did until the generator's
+// lid rows; it now calibrates to its whole range at that knee, and at a knee
+// of 2 or 2.5 % its re-solved +100 % pose lands 12-25 microns beside the
+// calibrated one: a tissue that stiff has more than one equilibrium there.)
+// (This was Song's eye sphincter on its whole skin, a
 // 46 s test, until the sphincters' areas were found on the surface: it now
 // cannot move its key node, estimated over bone, even an eighth, and is
 // skipped with a warning.)
 TEST(Calibration, AMuscleWhoseTissueLocksCalibratesToThePartItAllows) {
   FaceModelOptions fo;
-  fo.calibrate_only = {"frontalis_major_left"};
+  fo.calibrate_only = {"frontalis_outer_left"};
   fo.calibrate_jaw = false;
   for (SlabParams &slab : fo.tissue.slab) slab.knee = 0.03, slab.ratio = 1e3;
   Expected<FaceModel> m = build_face_model(head_1k().head.scene, head_1k().head.fdps, fo);
   ASSERT_TRUE(m.is_ok()) << m.status().message();
-  expect_calibrated_to_a_part(*m, "frontalis_major_left", "its tissue locks before the key node reaches");
+  expect_calibrated_to_a_part(*m, "frontalis_outer_left", "its tissue locks before the key node reaches");
 }
 
 // A non-essential muscle whose table range has no equilibrium the solver

@@ -902,18 +902,21 @@ TEST(FapSynthesis, FapsSharingAMuscleSplitTheSkinBetweenTheirFdps) {
 }
 
 // The simulation mesh (anatomy/sim_mesh.h) against the skin itself: the
-// 1k head's targets for FAPs 12 and 33 made on an 800-vertex copy of its
+// 1k head's targets for FAPs 12 and 33 made on a 750-vertex copy of its
 // skin and carried back agree with those made on the whole skin. The FDP
 // moves the same within the worst FDP error, 10 % of its motion,
-// off-axis included (measured: 5.4 % for FAP 33 since the lips keep all
-// their vertices and the brow gets fewer), the largest
-// motion is within 25 %, and over the skin the two displacement fields
-// differ by less than half the field (measured: 20 % for FAP 12, 35 % for
-// FAP 33, where the brow's muscles discretise differently; a binding that
-// carried the wrong corners differs by the whole field).
+// off-axis included (measured: 2.3 % for FAP 12, 1.1 % for FAP 33), the
+// largest motion is within 25 %, and over the skin the two displacement
+// fields differ by less than half the field (measured: 18 % for FAP 12,
+// 26 % for FAP 33, where the brow's muscles discretise differently; a
+// binding that carried the wrong corners differs by the whole field). (The
+// copy had 800 vertices until the 1k head got lid rows: its skin has 996
+// vertices since, and one of at most 1.25 times the copy's is not
+// decimated.)
 TEST(FapSynthesis, TargetsMadeOnACoarserSimulationMeshMatchTheSkins) {
   const Built &b = head_1k();
-  Expected<SimMesh> sim = make_sim_mesh(b.head.scene, b.head.fdps, SimMeshOptions{800});
+  const int kCoarse = 750;  // decimated: under 0.8 of the skin's 996 vertices
+  Expected<SimMesh> sim = make_sim_mesh(b.head.scene, b.head.fdps, SimMeshOptions{kCoarse});
   ASSERT_TRUE(sim.is_ok()) << sim.status().message();
   ASSERT_TRUE(sim->decimated);
   const Scene coarse = sim_scene(b.head.scene, *sim);
@@ -922,7 +925,7 @@ TEST(FapSynthesis, TargetsMadeOnACoarserSimulationMeshMatchTheSkins) {
   fo.calibrate_jaw = false;
   Expected<FaceModel> m = build_face_model(coarse, sim_fdps(b.head.fdps, *sim), fo);
   ASSERT_TRUE(m.is_ok()) << m.status().message();
-  EXPECT_EQ(m->tissue.n, 800);
+  EXPECT_EQ(m->tissue.n, kCoarse);
   FapSynthesisOptions o;
   o.only = {12, 33};
   o.negative_sides = false;
@@ -949,19 +952,22 @@ TEST(FapSynthesis, TargetsMadeOnACoarserSimulationMeshMatchTheSkins) {
     const double largest_made = made->displacement[skin].rowwise().norm().maxCoeff();
     EXPECT_LT(largest_made, 1.25 * largest_full) << "FAP " << fap;
     EXPECT_LT(diff, 0.5 * field) << "FAP " << fap;
+    std::printf("FAP %d on %d vertices: the FDP %.1f %% off, the field %.0f %%, the largest motion %.2f times\n", fap,
+                kCoarse, 100 * (at_made - at_full).norm() / at_full.norm(), 100 * diff / field,
+                largest_made / largest_full);
   }
 
   // The AFM stores the simulation mesh's motion on control points (LIFT):
   // every skin vertex is bound, and its lifted delta is the builder's within
   // half a quantum (the controls' rounding) plus the Q15 weights' rounding
   // (at most 2^-15 of each corner's delta, 3 corners).
-  ASSERT_EQ(syn->lift.control_count, 800);
+  ASSERT_EQ(syn->lift.control_count, kCoarse);
   const AfmContent content = fap_afm_content(b.head.scene, b.head.fdps, *m, *syn);
   const DocPtr hold = encoded_doc(content);
   const afm_doc *doc = hold.get();
   ASSERT_NE(doc, nullptr);
   ASSERT_NE(doc->lift, nullptr);
-  EXPECT_EQ(doc->lift->control_count, 800u);
+  EXPECT_EQ(doc->lift->control_count, static_cast<uint32_t>(kCoarse));
   const afm_part &skin_part = doc->geometry.parts[skin];
   ASSERT_EQ(doc->lift->runs[0].start, skin_part.first_vertex);
   ASSERT_GE(doc->lift->runs[0].length, skin_part.vertex_count);
@@ -1133,20 +1139,23 @@ TEST(FapSynthesis, SongsLidsCloseOverTheEyeballInBetweenTargetsIncluded) {
   }
 }
 
-// Joy on the generated 2k head, simulated on 1,000 vertices, folds the
-// cheeks over (0.08 % of the skin's area turned) where the zygomatici act.
-// Only the muscles to blame are reduced: risorius, the eye sphincters and
-// the jaw keep the table's contraction, and the target is that pose.
+// Joy on the generated 3k head, simulated on 1,500 vertices, folds the
+// cheeks over (0.093 % of the skin's area turned) where the zygomatici and
+// the eye sphincters act. Only the muscles to blame are reduced: risorius
+// and the jaw keep the table's contraction, and the target is that pose.
+// (This was the 2k head on 1,000 vertices until the generator got lid rows;
+// no expression of the 1k or 2k heads on 1,000 simulation vertices, or of
+// Song, tears now.)
 TEST(HighLevel, AnExpressionThatTearsTheSkinReducesTheMusclesThatTearIt) {
   RefHeadOptions ho;
-  ho.skin_vertices = 2000;
+  ho.skin_vertices = 3000;
   Expected<RefHead> head = make_reference_head(ho);
   ASSERT_TRUE(head.is_ok()) << head.status().message();
   const HighLevelMapping *h = find_high_level_mapping(true, 1);
   ASSERT_NE(h, nullptr);
   FaceModelOptions fo;
   for (const FapContraction &c : h->muscles) fo.calibrate_only.push_back(c.muscle);
-  Expected<SimFaceModel> sm = build_sim_face_model(head->scene, head->fdps, SimMeshOptions{1000}, fo);
+  Expected<SimFaceModel> sm = build_sim_face_model(head->scene, head->fdps, SimMeshOptions{1500}, fo);
   ASSERT_TRUE(sm.is_ok()) << sm.status().message();
   const FaceModel &m = sm->model;
   FapSynthesisOptions o;
@@ -1156,7 +1165,8 @@ TEST(HighLevel, AnExpressionThatTearsTheSkinReducesTheMusclesThatTearIt) {
   ASSERT_EQ(syn->outcomes.size(), 1u);
   const FapOutcome &out = syn->outcomes[0];
   ASSERT_TRUE(out.made) << out.message;
-  EXPECT_NE(out.message.find(": zygomaticus_major, zygomaticus_minor at "), std::string::npos) << out.message;
+  EXPECT_NE(out.message.find(": zygomaticus_major, zygomaticus_minor, orbicularis_oculi at "), std::string::npos)
+      << out.message;
   EXPECT_GT(out.scale, 0.0);
   EXPECT_LT(out.scale, 1.0);
   ASSERT_EQ(syn->targets.size(), 1u);
@@ -1176,12 +1186,11 @@ TEST(HighLevel, AnExpressionThatTearsTheSkinReducesTheMusclesThatTearIt) {
     ((jaw_motion(m.jaw, mid, 0, 0) * c - c).dot(dir) < drop ? lo : hi) = mid;
   }
   // The table's pose tears; the pose with the blamed muscles at the
-  // share and the rest (risorius, the eye sphincters, the jaw) at the
-  // table's is the target.
+  // share and the rest (risorius, the jaw) at the table's is the target.
   auto pose = [&](bool reduce) {
     Activation a;
     for (const FapContraction &k : h->muscles) {
-      const bool blamed = k.muscle.rfind("zygomaticus", 0) == 0;
+      const bool blamed = k.muscle.rfind("zygomaticus", 0) == 0 || k.muscle.rfind("orbicularis_oculi", 0) == 0;
       a.muscles.push_back({m.find(k.muscle), k.percent * (reduce && blamed ? out.scale : 1.0)});
     }
     a.jaw_open = 0.5 * (lo + hi);
@@ -1200,12 +1209,12 @@ TEST(HighLevel, AnExpressionThatTearsTheSkinReducesTheMusclesThatTearIt) {
   // a hundredth of a radius off the eyeballs (skin_model.h): squeezed onto
   // them by the eye sphincters, the lower lids have two equilibria, and the
   // start picks one, 29 quanta (0.14 mm) apart at a lower-lid vertex, 9 at
-  // the skin beside it (measured; a solver tolerance ten times finer gives
-  // the same two poses).
+  // the skin beside it (measured on the 2k head; a solver tolerance ten
+  // times finer gives the same two poses). On the 3k head: 24 quanta.
   const double apart = (D - reduced).rowwise().norm().maxCoeff();
   const double table_apart = (table - reduced).rowwise().norm().maxCoeff();
   EXPECT_LT(apart, 40 * m.quantum);
-  std::printf("joy on the 2k head: the target and the reduced pose %.1f quanta apart, the table's pose %.1f\n",
+  std::printf("joy on the 3k head: the target and the reduced pose %.1f quanta apart, the table's pose %.1f\n",
               apart / m.quantum, table_apart / m.quantum);
   EXPECT_GT(table_apart, 10 * apart);
   EXPECT_GT(table_apart, 10 * m.quantum);
