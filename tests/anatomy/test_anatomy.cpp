@@ -583,8 +583,11 @@ TEST(Physics, TheJawOpens) {
   const double chin_bottom = m.fdps.find(*FdpId::parse("2.1"))->pos.y();
   auto on_jaw = [&](int v) { return std::binary_search(m.jaw.vertices.begin(), m.jaw.vertices.end(), v); };
   ASSERT_FALSE(lips->lower.empty());
-  for (int v : lips->lower)
-    if (m.tissue.X0(v, 1) >= chin_bottom) EXPECT_TRUE(on_jaw(v)) << "lower-lip vertex " << v;
+  for (int v : lips->lower) {
+    if (m.tissue.X0(v, 1) >= chin_bottom) {
+      EXPECT_TRUE(on_jaw(v)) << "lower-lip vertex " << v;
+    }
+  }
   for (int v : lips->upper) EXPECT_FALSE(on_jaw(v)) << "upper-lip vertex " << v;
   std::printf("jaw: %zu vertices, %zu ray hits, %d removed, %d added\n", m.jaw.vertices.size(), m.jaw.ray_hits.size(),
               m.jaw.removed, m.jaw.added);
