@@ -152,11 +152,12 @@ double face_factor(double target) {
 // Rows over the eyes (the upper lids, up to the brow's foot) at most this
 // far apart, metres: a lid of one band of triangles cuts through the eyeball
 // as it closes, whatever holds its vertices off it (a chord of 4.4 mm dips
-// 0.2 mm into the 12.2 mm eyeball, one of 10 mm 1 mm). Never closer than
-// kLidRowsShare of the face's spacing, so that the lid's triangles do not
-// turn into slivers at coarse resolutions: the 1k and 2k heads get rows at
-// 0.45 of their face spacing (13.5 and 9.8 mm), the 5k head at 0.71, and the
-// 10k head's face spacing (4.1 mm) is fine enough as it is.
+// 0.2 mm into an eyeball of 12.2 mm radius, one of 10 mm 1 mm). Never
+// closer than kLidRowsShare of the face's spacing, so that the lid's
+// triangles do not turn into slivers at coarse resolutions: the 1k and 2k
+// heads get rows at 0.45 of their face spacing (13.5 and 9.8 mm), the 5k
+// head at 0.71, and the 10k head's face spacing (4.1 mm) is fine enough as
+// it is.
 constexpr double kLidRowSpacing = 4.4e-3;
 constexpr double kLidRowsShare = 0.45;
 
