@@ -112,6 +112,16 @@ std::vector<int8_t> over_eyeballs(const Eigen::MatrixXd &V, const Eigen::MatrixX
 
 }  // namespace
 
+double eye_clearance_in(const SkinModel &m, int v, const Eigen::MatrixXd &X) {
+  const int8_t eye = m.eye_near[static_cast<size_t>(v)];
+  const Eigen::RowVector3d x = X.row(m.node(kEpidermis, v)), x0 = m.X0.row(v);
+  double grown = 0;
+  for (int u : m.neighbours[static_cast<size_t>(v)])
+    if (m.eye_near[static_cast<size_t>(u)] == eye)
+      grown = std::max(grown, (x - X.row(m.node(kEpidermis, u))).squaredNorm() - (x0 - m.X0.row(u)).squaredNorm());
+  return m.eye_clearance[static_cast<size_t>(v)] + grown / (8.0 * m.eyes[static_cast<size_t>(eye)].radius);
+}
+
 std::vector<EyeSphere> fit_eyeballs(const Scene &scene) {
   std::vector<EyeSphere> eyes;
   for (PartKind kind : {PartKind::EyeLeft, PartKind::EyeRight}) {

@@ -137,10 +137,11 @@ struct SkinModel {
   // eyeball keeps its skull plane until it meets the sphere.
   std::vector<int8_t> eye_near;
   // Per vertex: how far off its eyeball's sphere the epidermal node is held
-  // (model units): its distance at rest, up to kEyeClearance radii or its
-  // longest edge's chord dip l^2 / (8 r), whichever is more. On the sphere
-  // itself the skin between nodes, a chord, and the eye part's vertices
-  // cross: Song's eyeball showed through the lid as dark specks.
+  // at rest (model units): its distance at rest, up to kEyeClearance radii or
+  // its longest edge's chord dip l^2 / (8 r), whichever is more. On the
+  // sphere itself the skin between nodes, a chord, and the eye part's
+  // vertices cross: Song's eyeball showed through the lid as dark specks.
+  // In a pose it grows as the edges stretch (eye_clearance_in).
   std::vector<double> eye_clearance;
 
   int node(int layer, int vertex) const { return layer * n + vertex; }
@@ -149,6 +150,16 @@ struct SkinModel {
   // The stiffness a spring has now (0 for a bone tie of a skull-free vertex).
   double stiffness(const Spring &s) const;
 };
+
+// How far off its eyeball's sphere the solver holds vertex v's epidermal
+// node in pose X (4n x 3; v must have eye_near[v] >= 0), model units:
+// eye_clearance[v] plus what the chords to its neighbours held by the same
+// eyeball dip further as they stretch, (l^2 - l0^2) / (8 r) for the longest
+// growth (two nodes held h off a ball of radius r keep their chord of length
+// l outside it when h >= l^2 / (8 r)). A closing lid stretches: on the 2k
+// head its triangles grew to 11 mm over a 12.2 mm eyeball, and held at their
+// rest clearance the eye part showed through them.
+double eye_clearance_in(const SkinModel &m, int v, const Eigen::MatrixXd &X);
 
 // The eyeballs of a scene: a sphere fitted to each eye part (left, then
 // right; an eye part whose vertices are not a sphere, within a tenth of its

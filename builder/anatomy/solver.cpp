@@ -424,7 +424,7 @@ double update_contacts(const System &sys, Eigen::MatrixXd &X, Contacts &c) {
       const Eigen::Vector3d q = X.row(g).transpose() - e.centre;
       const double d = q.norm();
       if (!(d > 0)) continue;
-      const double gap = d - e.radius - m.eye_clearance[static_cast<size_t>(m.vertex_of(g))];
+      const double gap = d - e.radius - eye_clearance_in(m, m.vertex_of(g), X);
       // Once on the eye, a node stays on it; a node that also has a skull
       // plane leaves it for the eye when it meets the ball.
       const bool on = (was && c.on_eye[i]) || gap < 0;

@@ -38,9 +38,10 @@
 //             constrained;
 //   eyeballs  the epidermal node of a vertex near an eyeball
 //             (SkinModel::eye_near) is held off its sphere, grown by the
-//             node's clearance (SkinModel::eye_clearance), the same way: put
-//             back on it when inside, then held with the sphere's tangent
-//             plane at the node, renewed at every update, as its plane. A
+//             node's clearance in the pose (eye_clearance_in: the rest one
+//             grown as its edges stretch), the same way: put back on it when
+//             inside, then held with the sphere's tangent plane at the node,
+//             renewed at every update, as its plane. A
 //             node that also has a skull plane keeps it until it meets the
 //             sphere.
 //
