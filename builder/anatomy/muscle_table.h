@@ -48,8 +48,8 @@ struct MuscleDef {
   // anatomical action, a positive contraction here, pushes.
   int sense;
   // The displacement at +100 % and at -100 % contraction (section 3.3),
-  // as fractions of the fibre length (linear: the insertion moves along the
-  // fibre) or of the semi-axis (sphincter: the semi-axis key node moves
+  // as fractions of the fibre length (linear: the insertion moves along its
+  // pull, muscles.h) or of the semi-axis (sphincter: the semi-axis key node moves
   // toward the epicentre; which axis is `calibrate_minor`; lid: the margin
   // moves along the eyeball toward the other lid, a fraction of the opening).
   double max_fraction, min_fraction;
@@ -61,6 +61,13 @@ struct MuscleDef {
   // Without it the face cannot make its basic FAPs: a build without its FDPs
   // fails instead of skipping the muscle.
   bool essential;
+  // Linear: the muscle lies along the bone, under the skin (frontalis,
+  // corrugator, the zygomatici, risorius, depressor anguli): it pulls each
+  // node of its area along the skin's surface, toward the attachment's side
+  // (the straight line to the attachment, its normal part dropped). Others
+  // (mentalis, nasalis, upper lip) pull along the straight line through the
+  // tissue, as Waters' vector muscle does. docs/anatomy.md, "Muscles".
+  bool along_surface;
   // Lid: the eye's corners (outer, inner), where the margin is held: the
   // load fades to nothing there. Others: nullptr.
   const char *corner_outer = nullptr, *corner_inner = nullptr;

@@ -25,8 +25,8 @@ Status missing(const MuscleDef &d, const std::vector<FdpId> &ids) {
 }
 
 // A dead load: force c w_i u_i on each influence node, u_i its direction at
-// rest (`direction` of the rest position; zero: no force); potential
-// -c sum_i w_i (p_i - p0_i) . u_i.
+// rest (`direction` of the vertex and its node's rest position; zero: no
+// force); potential -c sum_i w_i (p_i - p0_i) . u_i.
 template <class Direction>
 double dead_load(const SkinModel &skin, const Muscle &m, double c, const Direction &direction,
                  const Eigen::MatrixXd &X, Eigen::MatrixXd *F) {
@@ -34,11 +34,26 @@ double dead_load(const SkinModel &skin, const Muscle &m, double c, const Directi
   for (size_t i = 0; i < m.influence.size(); ++i) {
     const int node = skin.node(m.force_layer, m.influence[i]);
     const Eigen::Vector3d x0 = skin.X0.row(node);
-    const Eigen::Vector3d u = direction(x0);
+    const Eigen::Vector3d u = direction(m.influence[i], x0);
     energy -= c * m.weight[i] * (X.row(node).transpose() - x0).dot(u);
     if (F) F->row(node) += (c * m.weight[i]) * u.transpose();
   }
   return energy;
+}
+
+// The unit direction in which a linear muscle pulls skin vertex v, whose
+// force node rests at x0: toward the attachment; for a muscle that lies
+// along the bone (MuscleDef::along_surface) that direction's part in the
+// skin's tangent plane at v, at full length, since the fibre wraps over
+// the skull and the bone takes its normal part. Zero where the attachment
+// lies along the normal.
+Eigen::Vector3d linear_pull(const SkinModel &skin, const Muscle &m, int v, const Eigen::Vector3d &x0) {
+  const Eigen::Vector3d d = (skin.X0.row(m.node_a).transpose() - x0).normalized();
+  if (!muscle_table()[static_cast<size_t>(m.def)].along_surface) return d;
+  const Eigen::Vector3d nrm = skin.normal.row(v).transpose();
+  const Eigen::Vector3d t = d - nrm.dot(d) * nrm;
+  const double len = t.norm();
+  return len > 1e-6 ? Eigen::Vector3d(t / len) : Eigen::Vector3d::Zero();
 }
 
 // Breadth-first search over the skin mesh from vertex `start` through the
@@ -314,9 +329,8 @@ double muscle_load(const SkinModel &skin, const Muscle &m, double tension, const
   if (m.kind == MuscleKind::Linear) {
     // Directions at rest: a pull toward a moving point is stable, a push
     // away from one (mentalis, negative contractions) is not, transversally.
-    const Eigen::Vector3d a = skin.X0.row(m.node_a);
-    energy = dead_load(skin, m, s, [&](const Eigen::Vector3d &x0) { return Eigen::Vector3d((a - x0).normalized()); },
-                       X, F);
+    energy = dead_load(skin, m, s, [&](int v, const Eigen::Vector3d &x0) { return linear_pull(skin, m, v, x0); }, X,
+                       F);
   } else if (m.kind == MuscleKind::Lid) {
     if (m.eye < 0 || static_cast<size_t>(m.eye) >= skin.eyes.size()) return 0.0;  // a model without its eyeball
     const double radius = skin.eyes[static_cast<size_t>(m.eye)].radius, floor = kLidAxisFloor * radius;
@@ -349,7 +363,7 @@ double muscle_load(const SkinModel &skin, const Muscle &m, double tension, const
     // Widening: a dead load outward along the rest direction from the
     // epicentre. A push away from the moving epicentre direction would be
     // unstable around it (negative stiffness across the radius).
-    energy = dead_load(skin, m, -s, [&](const Eigen::Vector3d &x0) {
+    energy = dead_load(skin, m, -s, [&](int, const Eigen::Vector3d &x0) {
       const Eigen::Vector3d d0(x0.x() - m.epicentre.x(), x0.y() - m.epicentre.y(), 0.0);
       return d0.norm() > 0 ? Eigen::Vector3d(d0.normalized()) : Eigen::Vector3d::Zero().eval();
     }, X, F);
@@ -381,8 +395,9 @@ double muscle_load(const SkinModel &skin, const Muscle &m, double tension, const
 
 double muscle_action(const SkinModel &skin, const Muscle &m, const Eigen::MatrixXd &X, Eigen::MatrixXd *gradient) {
   if (m.kind == MuscleKind::Linear) {
-    const Eigen::Vector3d a0 = skin.X0.row(m.node_a), b0 = skin.X0.row(m.node_b), b = X.row(m.node_b);
-    const Eigen::Vector3d dir = m.sense * (a0 - b0).normalized();
+    // Along the insertion's own pull.
+    const Eigen::Vector3d b0 = skin.X0.row(m.node_b), b = X.row(m.node_b);
+    const Eigen::Vector3d dir = m.sense * linear_pull(skin, m, skin.vertex_of(m.node_b), b0);
     if (gradient) gradient->row(m.node_b) += dir.transpose();
     return (b - b0).dot(dir);
   }

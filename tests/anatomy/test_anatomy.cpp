@@ -458,6 +458,27 @@ TEST(Physics, EachMuscleMovesItsRegionTheWayAnatomySays) {
   }
 }
 
+// The muscles that lie along the bone (MuscleDef::along_surface) move the
+// skin along its surface: the skin's motion at the insertion is mostly
+// tangent to it. Pulled straight toward an attachment on the skull, as
+// Waters' vector muscle does, the skin went into the face as much as along
+// it (docs/anatomy.md, "Muscles"), and the FAPs' FDPs with it.
+TEST(Physics, MusclesAlongTheBoneMoveTheSkinAlongItsSurface) {
+  const FaceModel &m = head_1k().model;
+  for (const char *name : {"frontalis_inner_left", "frontalis_major_left", "frontalis_outer_left", "corrugator_left",
+                           "zygomaticus_major_left", "risorius_left", "depressor_anguli_left"}) {
+    const Muscle &mu = m.muscles[static_cast<size_t>(m.find(name))];
+    ASSERT_TRUE(muscle_table()[static_cast<size_t>(mu.def)].along_surface) << name;
+    const Eigen::MatrixXd X = contract(m, name, 0.05);
+    const int v = m.tissue.vertex_of(mu.node_b);
+    const Eigen::Vector3d d = X.row(v) - m.tissue.X0.row(v), n = m.tissue.normal.row(v);
+    std::printf("%-24s insertion moved %.3f mm, %.2f of it along the normal\n", name, mm(d.norm()),
+                std::abs(d.dot(n)) / d.norm());
+    EXPECT_GT(mm(d.norm()), 0.2) << name;
+    EXPECT_LT(std::abs(d.dot(n)), 0.2 * d.norm()) << name;
+  }
+}
+
 // The lids ride over the eyeballs (skin_model.h): spheres fitted to the eye
 // parts, which the generator made as spheres of known centre and radius.
 // Closing the eye hard presses the upper lid onto its eyeball; without the

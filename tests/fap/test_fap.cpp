@@ -1140,9 +1140,11 @@ TEST(FapSynthesis, SongsLidsCloseOverTheEyeballInBetweenTargetsIncluded) {
 }
 
 // Joy on the generated 3k head, simulated on 1,500 vertices, folds the
-// cheeks over (0.093 % of the skin's area turned) where the zygomatici and
-// the eye sphincters act. Only the muscles to blame are reduced: risorius
-// and the jaw keep the table's contraction, and the target is that pose.
+// cheeks over (0.048 % of the skin's area turned) where the zygomatici act.
+// Only the muscles to blame are reduced: risorius, the eye sphincters and
+// the jaw keep the table's contraction, and the target is that pose. (Until
+// the zygomatici pulled along the skin's surface, the fold was 0.093 % and
+// the eye sphincters were blamed too.)
 // (This was the 2k head on 1,000 vertices until the generator got lid rows;
 // no expression of the 1k or 2k heads on 1,000 simulation vertices, or of
 // Song, tears now.)
@@ -1165,7 +1167,7 @@ TEST(HighLevel, AnExpressionThatTearsTheSkinReducesTheMusclesThatTearIt) {
   ASSERT_EQ(syn->outcomes.size(), 1u);
   const FapOutcome &out = syn->outcomes[0];
   ASSERT_TRUE(out.made) << out.message;
-  EXPECT_NE(out.message.find(": zygomaticus_major, zygomaticus_minor, orbicularis_oculi at "), std::string::npos)
+  EXPECT_NE(out.message.find(": zygomaticus_major, zygomaticus_minor at "), std::string::npos)
       << out.message;
   EXPECT_GT(out.scale, 0.0);
   EXPECT_LT(out.scale, 1.0);
@@ -1190,7 +1192,7 @@ TEST(HighLevel, AnExpressionThatTearsTheSkinReducesTheMusclesThatTearIt) {
   auto pose = [&](bool reduce) {
     Activation a;
     for (const FapContraction &k : h->muscles) {
-      const bool blamed = k.muscle.rfind("zygomaticus", 0) == 0 || k.muscle.rfind("orbicularis_oculi", 0) == 0;
+      const bool blamed = k.muscle.rfind("zygomaticus", 0) == 0;
       a.muscles.push_back({m.find(k.muscle), k.percent * (reduce && blamed ? out.scale : 1.0)});
     }
     a.jaw_open = 0.5 * (lo + hi);
