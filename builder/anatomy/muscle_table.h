@@ -62,11 +62,12 @@ struct MuscleDef {
   // fails instead of skipping the muscle.
   bool essential;
   // Linear: the muscle lies along the bone, under the skin (frontalis,
-  // corrugator, the zygomatici, risorius, depressor anguli): it pulls each
-  // node of its area along the skin's surface, toward the attachment's side
-  // (the straight line to the attachment, its normal part dropped). Others
-  // (mentalis, nasalis, upper lip) pull along the straight line through the
-  // tissue, as Waters' vector muscle does. docs/anatomy.md, "Muscles".
+  // corrugator, zygomaticus major, risorius, depressor anguli): it pulls
+  // each node of its area along the skin's surface, toward the attachment's
+  // side (the straight line to the attachment, its normal part dropped).
+  // Others (mentalis, nasalis, upper lip, zygomaticus minor) pull along the
+  // straight line through the tissue, as Waters' vector muscle does.
+  // docs/anatomy.md, "Muscles", says why each.
   bool along_surface;
   // Lid: the eye's corners (outer, inner), where the margin is held: the
   // load fades to nothing there. Others: nullptr.
