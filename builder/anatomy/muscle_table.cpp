@@ -16,9 +16,15 @@ using K = MuscleKind;
 // Decisions where the paper's tables slip (docs/anatomy.md):
 //  - frontalis_inner_right: the paper writes 11.3 (the left hairline) in its
 //    attachment; every other right frontalis uses 11.2, so 11.2 here.
-//  - risorius_right: the paper starts it at 5.4, which makes it the same
-//    fibre as zygomaticus_major_right (5.4 -> 8.4); the left one starts at
-//    5.1 (the cheek's centre), so the right one starts at 5.2.
+//  - risorius: the paper starts the left one at 5.1 (the cheek's centre,
+//    up from the corner: 36 degrees on Song, 5.3 units away) and the right
+//    one at 5.4, which makes it the same fibre as zygomaticus_major_right
+//    (5.4 -> 8.4). The muscle runs level from the corner to the fascia over
+//    the masseter and stretches the lips sideways (FACS AU 20, MPEG-4's
+//    stretch_cornerlip), so here it starts level with its corner, half the
+//    mouth's width beyond it: 8.3 + 1/2 (8.3 - 8.4) (the right one
+//    mirrored), with 15 % of that fibre as its range (20 % folded the skin
+//    beside Song's corners in viseme I).
 //  - orbicularis_oris: the paper's epicentre (n + m) / 2 with n = 8.2,
 //    m = 8.3 lies between the lower lip and the left corner; the mouth's
 //    centre, halfway between 8.1 and 8.2, here.
@@ -49,8 +55,8 @@ const std::vector<MuscleDef> kTable = {
     {"zygomaticus_minor_right", K::Linear, "3.10", "8.6 + 1/2 (2.7 - 8.6)", nullptr, 0.20, +1, 0.20, 0.06, false, true, false, false},
     {"zygomaticus_major_left", K::Linear, "5.3", "8.3", nullptr, 0.25, +1, 0.25, 0.08, false, true, true, true},
     {"zygomaticus_major_right", K::Linear, "5.4", "8.4", nullptr, 0.25, +1, 0.25, 0.08, false, true, true, true},
-    {"risorius_left", K::Linear, "5.1", "8.3", nullptr, 0.25, +1, 0.20, 0.06, false, true, true, true},
-    {"risorius_right", K::Linear, "5.2", "8.4", nullptr, 0.25, +1, 0.20, 0.06, false, true, true, true},
+    {"risorius_left", K::Linear, "8.3 + 1/2 (8.3 - 8.4)", "8.3", nullptr, 0.25, +1, 0.15, 0.06, false, true, true, true},
+    {"risorius_right", K::Linear, "8.4 + 1/2 (8.4 - 8.3)", "8.4", nullptr, 0.25, +1, 0.15, 0.06, false, true, true, true},
     {"depressor_anguli_left", K::Linear, "8.3 + (8.3 - 9.1)", "8.3", nullptr, 0.35, +1, 0.30, 0.10, false, false, true, true},
     {"depressor_anguli_right", K::Linear, "8.4 + (8.4 - 9.2)", "8.4", nullptr, 0.35, +1, 0.30, 0.10, false, false, true, true},
     {"mentalis_left", K::Linear, "2.10 + (2.8 - 2.3)", "2.8", nullptr, 0.45, -1, 0.12, 0.08, false, false, true, false},
