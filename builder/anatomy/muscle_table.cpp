@@ -9,10 +9,11 @@ namespace afmb {
 namespace {
 
 using K = MuscleKind;
+using L = PullLine;
 
 // name, kind, attachment | semi-major end, insertion | semi-minor end, epicentre,
-// width, sense, max, min, calibrate_minor, skull_free, essential,
-// along_surface[, the lid's corners].
+// width, sense, max, min, calibrate_minor, skull_free, essential, line[, the
+// lid's corners].
 // Decisions where the paper's tables slip (docs/anatomy.md):
 //  - frontalis_inner_right: the paper writes 11.3 (the left hairline) in its
 //    attachment; every other right frontalis uses 11.2, so 11.2 here.
@@ -39,38 +40,38 @@ using K = MuscleKind;
 //    fibres then missed the lower lip's middle. From the chin straight below
 //    its insertion here, pushing the lip up, wider and with a larger range.
 const std::vector<MuscleDef> kTable = {
-    {"frontalis_inner_left", K::Linear, "11.1 + 1/6 (11.3 - 11.1)", "4.1", nullptr, 0.30, +1, 0.18, 0.06, false, false, false, true},
-    {"frontalis_inner_right", K::Linear, "11.1 + 1/6 (11.2 - 11.1)", "4.2", nullptr, 0.30, +1, 0.18, 0.06, false, false, false, true},
-    {"frontalis_major_left", K::Linear, "11.1 + 1/3 (11.3 - 11.1)", "4.3", nullptr, 0.30, +1, 0.18, 0.06, false, false, false, true},
-    {"frontalis_major_right", K::Linear, "11.1 + 1/3 (11.2 - 11.1)", "4.4", nullptr, 0.30, +1, 0.18, 0.06, false, false, false, true},
-    {"frontalis_outer_left", K::Linear, "11.1 + 2/3 (11.3 - 11.1)", "4.5", nullptr, 0.30, +1, 0.18, 0.06, false, false, false, true},
-    {"frontalis_outer_right", K::Linear, "11.1 + 2/3 (11.2 - 11.1)", "4.6", nullptr, 0.30, +1, 0.18, 0.06, false, false, false, true},
-    {"corrugator_left", K::Linear, "4.1 + 1/3 (4.2 - 4.1)", "4.3", nullptr, 0.40, +1, 0.25, 0.08, false, false, false, true},
-    {"corrugator_right", K::Linear, "4.2 + 1/3 (4.1 - 4.2)", "4.4", nullptr, 0.40, +1, 0.25, 0.08, false, false, false, true},
-    {"nasalis_left", K::Linear, "9.7", "9.1", nullptr, 0.30, +1, 0.15, 0.05, false, false, false, false},
-    {"nasalis_right", K::Linear, "9.6", "9.2", nullptr, 0.30, +1, 0.15, 0.05, false, false, false, false},
-    {"upper_lip_left", K::Linear, "9.5 + 1/2 (9.15 - 9.5)", "8.10", nullptr, 0.40, -1, 0.40, 0.15, false, true, false, false},
-    {"upper_lip_right", K::Linear, "9.4 + 1/2 (9.15 - 9.4)", "8.9", nullptr, 0.40, -1, 0.40, 0.15, false, true, false, false},
-    {"zygomaticus_minor_left", K::Linear, "3.9", "8.5 + 1/2 (2.6 - 8.5)", nullptr, 0.20, +1, 0.20, 0.06, false, true, false, false},
-    {"zygomaticus_minor_right", K::Linear, "3.10", "8.6 + 1/2 (2.7 - 8.6)", nullptr, 0.20, +1, 0.20, 0.06, false, true, false, false},
-    {"zygomaticus_major_left", K::Linear, "5.3", "8.3", nullptr, 0.25, +1, 0.25, 0.08, false, true, true, true},
-    {"zygomaticus_major_right", K::Linear, "5.4", "8.4", nullptr, 0.25, +1, 0.25, 0.08, false, true, true, true},
-    {"risorius_left", K::Linear, "8.3 + 1/2 (8.3 - 8.4)", "8.3", nullptr, 0.25, +1, 0.15, 0.06, false, true, true, true},
-    {"risorius_right", K::Linear, "8.4 + 1/2 (8.4 - 8.3)", "8.4", nullptr, 0.25, +1, 0.15, 0.06, false, true, true, true},
-    {"depressor_anguli_left", K::Linear, "8.3 + (8.3 - 9.1)", "8.3", nullptr, 0.35, +1, 0.30, 0.10, false, false, true, true},
-    {"depressor_anguli_right", K::Linear, "8.4 + (8.4 - 9.2)", "8.4", nullptr, 0.35, +1, 0.30, 0.10, false, false, true, true},
-    {"mentalis_left", K::Linear, "2.10 + (2.8 - 2.3)", "2.8", nullptr, 0.45, -1, 0.12, 0.08, false, false, true, false},
-    {"mentalis_right", K::Linear, "2.10 + (2.9 - 2.3)", "2.9", nullptr, 0.45, -1, 0.12, 0.08, false, false, true, false},
-    {"orbicularis_oculi_left", K::Sphincter, "3.7", "3.9", "3.5", 1.8, +1, 0.50, 0.20, true, false, false, false},
-    {"orbicularis_oculi_right", K::Sphincter, "3.12", "3.10", "3.6", 1.8, +1, 0.50, 0.20, true, false, false, false},
-    {"orbicularis_oris", K::Sphincter, "8.3", "8.2", "1/2 (8.1 + 8.2)", 1.6, +1, 0.25, 0.10, false, true, true, false},
+    {"frontalis_inner_left", K::Linear, "11.1 + 1/6 (11.3 - 11.1)", "4.1", nullptr, 0.30, +1, 0.18, 0.06, false, false, false, L::Surface},
+    {"frontalis_inner_right", K::Linear, "11.1 + 1/6 (11.2 - 11.1)", "4.2", nullptr, 0.30, +1, 0.18, 0.06, false, false, false, L::Surface},
+    {"frontalis_major_left", K::Linear, "11.1 + 1/3 (11.3 - 11.1)", "4.3", nullptr, 0.30, +1, 0.18, 0.06, false, false, false, L::Surface},
+    {"frontalis_major_right", K::Linear, "11.1 + 1/3 (11.2 - 11.1)", "4.4", nullptr, 0.30, +1, 0.18, 0.06, false, false, false, L::Surface},
+    {"frontalis_outer_left", K::Linear, "11.1 + 2/3 (11.3 - 11.1)", "4.5", nullptr, 0.30, +1, 0.18, 0.06, false, false, false, L::Surface},
+    {"frontalis_outer_right", K::Linear, "11.1 + 2/3 (11.2 - 11.1)", "4.6", nullptr, 0.30, +1, 0.18, 0.06, false, false, false, L::Surface},
+    {"corrugator_left", K::Linear, "4.1 + 1/3 (4.2 - 4.1)", "4.3", nullptr, 0.40, +1, 0.25, 0.08, false, false, false, L::Surface},
+    {"corrugator_right", K::Linear, "4.2 + 1/3 (4.1 - 4.2)", "4.4", nullptr, 0.40, +1, 0.25, 0.08, false, false, false, L::Surface},
+    {"nasalis_left", K::Linear, "9.7", "9.1", nullptr, 0.30, +1, 0.15, 0.05, false, false, false, L::Skull},
+    {"nasalis_right", K::Linear, "9.6", "9.2", nullptr, 0.30, +1, 0.15, 0.05, false, false, false, L::Skull},
+    {"upper_lip_left", K::Linear, "9.5 + 1/2 (9.15 - 9.5)", "8.10", nullptr, 0.40, -1, 0.40, 0.15, false, true, false, L::Skull},
+    {"upper_lip_right", K::Linear, "9.4 + 1/2 (9.15 - 9.4)", "8.9", nullptr, 0.40, -1, 0.40, 0.15, false, true, false, L::Skull},
+    {"zygomaticus_minor_left", K::Linear, "3.9", "8.5 + 1/2 (2.6 - 8.5)", nullptr, 0.20, +1, 0.20, 0.06, false, true, false, L::Skull},
+    {"zygomaticus_minor_right", K::Linear, "3.10", "8.6 + 1/2 (2.7 - 8.6)", nullptr, 0.20, +1, 0.20, 0.06, false, true, false, L::Skull},
+    {"zygomaticus_major_left", K::Linear, "5.3", "8.3", nullptr, 0.25, +1, 0.25, 0.08, false, true, true, L::Surface},
+    {"zygomaticus_major_right", K::Linear, "5.4", "8.4", nullptr, 0.25, +1, 0.25, 0.08, false, true, true, L::Surface},
+    {"risorius_left", K::Linear, "8.3 + 1/2 (8.3 - 8.4)", "8.3", nullptr, 0.25, +1, 0.15, 0.06, false, true, true, L::Surface},
+    {"risorius_right", K::Linear, "8.4 + 1/2 (8.4 - 8.3)", "8.4", nullptr, 0.25, +1, 0.15, 0.06, false, true, true, L::Surface},
+    {"depressor_anguli_left", K::Linear, "8.3 + (8.3 - 9.1)", "8.3", nullptr, 0.35, +1, 0.30, 0.10, false, false, true, L::Surface},
+    {"depressor_anguli_right", K::Linear, "8.4 + (8.4 - 9.2)", "8.4", nullptr, 0.35, +1, 0.30, 0.10, false, false, true, L::Surface},
+    {"mentalis_left", K::Linear, "2.10 + (2.8 - 2.3)", "2.8", nullptr, 0.45, -1, 0.12, 0.08, false, false, true, L::Key},
+    {"mentalis_right", K::Linear, "2.10 + (2.9 - 2.3)", "2.9", nullptr, 0.45, -1, 0.12, 0.08, false, false, true, L::Key},
+    {"orbicularis_oculi_left", K::Sphincter, "3.7", "3.9", "3.5", 1.8, +1, 0.50, 0.20, true, false, false, L::Skull},
+    {"orbicularis_oculi_right", K::Sphincter, "3.12", "3.10", "3.6", 1.8, +1, 0.50, 0.20, true, false, false, L::Skull},
+    {"orbicularis_oris", K::Sphincter, "8.3", "8.2", "1/2 (8.1 + 8.2)", 1.6, +1, 0.25, 0.10, false, true, true, L::Skull},
     // The lids (not in the paper; docs/anatomy.md "The lids"). +100 % takes
     // the upper margin nine tenths of the opening down the eyeball, -100 %
     // (levator palpebrae) a quarter up; the lower lid half and a sixth.
-    {"palpebral_upper_left", K::Lid, "3.1", "3.3", nullptr, 0, +1, 0.90, 0.25, false, true, false, false, "3.7", "3.11"},
-    {"palpebral_upper_right", K::Lid, "3.2", "3.4", nullptr, 0, +1, 0.90, 0.25, false, true, false, false, "3.8", "3.12"},
-    {"palpebral_lower_left", K::Lid, "3.3", "3.1", nullptr, 0, +1, 0.50, 0.15, false, true, false, false, "3.7", "3.11"},
-    {"palpebral_lower_right", K::Lid, "3.4", "3.2", nullptr, 0, +1, 0.50, 0.15, false, true, false, false, "3.8", "3.12"},
+    {"palpebral_upper_left", K::Lid, "3.1", "3.3", nullptr, 0, +1, 0.90, 0.25, false, true, false, L::Skull, "3.7", "3.11"},
+    {"palpebral_upper_right", K::Lid, "3.2", "3.4", nullptr, 0, +1, 0.90, 0.25, false, true, false, L::Skull, "3.8", "3.12"},
+    {"palpebral_lower_left", K::Lid, "3.3", "3.1", nullptr, 0, +1, 0.50, 0.15, false, true, false, L::Skull, "3.7", "3.11"},
+    {"palpebral_lower_right", K::Lid, "3.4", "3.2", nullptr, 0, +1, 0.50, 0.15, false, true, false, L::Skull, "3.8", "3.12"},
 };
 
 struct Parser {

@@ -22,6 +22,18 @@ namespace afmb {
 // lid about its eyeball's horizontal axis (muscles.h). Not in the paper.
 enum class MuscleKind { Linear, Sphincter, Lid };
 
+// The line a linear muscle pulls (or pushes) each node of its area along
+// (muscles.h, linear_pull; docs/anatomy.md, "Muscles", says why each muscle
+// has its own):
+//   Skull    straight toward the attachment's skull node, through the
+//            tissue: Waters' vector muscle, as the paper maps it;
+//   Surface  that line's part in the skin's tangent plane at the node's
+//            vertex: a muscle lying along the bone under the skin, whose
+//            fibre wraps over the skull;
+//   Key      straight toward the attachment's key point itself, on the
+//            skin's surface where the FDPs are: a push from below the skin.
+enum class PullLine { Skull, Surface, Key };
+
 // One row of Table 1 or 2 plus the constants the paper leaves to the
 // implementer. Sides are the face's own (MPEG-4: left is +x).
 struct MuscleDef {
@@ -61,14 +73,11 @@ struct MuscleDef {
   // Without it the face cannot make its basic FAPs: a build without its FDPs
   // fails instead of skipping the muscle.
   bool essential;
-  // Linear: the muscle lies along the bone, under the skin (frontalis,
-  // corrugator, zygomaticus major, risorius, depressor anguli): it pulls
-  // each node of its area along the skin's surface, toward the attachment's
-  // side (the straight line to the attachment, its normal part dropped).
-  // Others (mentalis, nasalis, upper lip, zygomaticus minor) pull along the
-  // straight line through the tissue, as Waters' vector muscle does.
-  // docs/anatomy.md, "Muscles", says why each.
-  bool along_surface;
+  // Linear: its line of action (PullLine): Surface for the muscles along the
+  // bone (frontalis, corrugator, zygomaticus major, risorius, depressor
+  // anguli), Key for mentalis' push, Skull for the others (nasalis, upper
+  // lip, zygomaticus minor). Others: Skull (unused).
+  PullLine line;
   // Lid: the eye's corners (outer, inner), where the margin is held: the
   // load fades to nothing there. Others: nullptr.
   const char *corner_outer = nullptr, *corner_inner = nullptr;

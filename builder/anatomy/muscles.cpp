@@ -42,14 +42,18 @@ double dead_load(const SkinModel &skin, const Muscle &m, double c, const Directi
 }
 
 // The unit direction in which a linear muscle pulls skin vertex v, whose
-// force node rests at x0: toward the attachment; for a muscle that lies
-// along the bone (MuscleDef::along_surface) that direction's part in the
-// skin's tangent plane at v, at full length, since the fibre wraps over
-// the skull and the bone takes its normal part. Zero where the attachment
-// lies along the normal.
+// force node rests at x0, along its PullLine: toward the attachment's skull
+// node, or its key point (a push from below the skin: from the skull node,
+// a tissue's depth behind, the push came out of the face); for a muscle
+// that lies along the bone, the skull line's part in the skin's tangent
+// plane at v, at full length, since the fibre wraps over the skull and the
+// bone takes its normal part (zero where the attachment lies along the
+// normal).
 Eigen::Vector3d linear_pull(const SkinModel &skin, const Muscle &m, int v, const Eigen::Vector3d &x0) {
-  const Eigen::Vector3d d = (skin.X0.row(m.node_a).transpose() - x0).normalized();
-  if (!muscle_table()[static_cast<size_t>(m.def)].along_surface) return d;
+  const PullLine line = muscle_table()[static_cast<size_t>(m.def)].line;
+  const Eigen::Vector3d a = line == PullLine::Key ? m.key_a : Eigen::Vector3d(skin.X0.row(m.node_a).transpose());
+  const Eigen::Vector3d d = (a - x0).normalized();
+  if (line != PullLine::Surface) return d;
   const Eigen::Vector3d nrm = skin.normal.row(v).transpose();
   const Eigen::Vector3d t = d - nrm.dot(d) * nrm;
   const double len = t.norm();

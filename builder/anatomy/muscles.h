@@ -5,10 +5,11 @@
 // Linear muscle (attachment A on the skull, insertion I on the dermis, fibre
 // length L = |I - A| at rest). A dermis node p is in the influence area when
 // its distance to the segment AI is below omega L (the width coefficient).
-// It is pulled toward A (along the rest direction; for a muscle that lies
-// along the bone, MuscleDef::along_surface, that direction's part in the
-// skin's tangent plane at p's vertex, scaled back to unit length) with the
-// weight
+// It is pulled toward A (along the rest direction; MuscleDef::line: for a
+// muscle that lies along the bone, that direction's part in the skin's
+// tangent plane at p's vertex, scaled back to unit length; for mentalis'
+// push, the direction from the attachment's key point instead of its node)
+// with the weight
 //   w = area(p) cos(alpha) R(D),   alpha = angle(I - A, p - A) (0 beyond 90 deg),
 //   D = |p - A|,  R = sin(pi/2 D / L)                       for D <= L,
 //                 R = cos(pi/2 (D - L) / (omega L))          for L < D <= (1 + omega) L,
@@ -138,7 +139,7 @@ void remove_from_influence(Muscle &m, const std::vector<int> &vertices);
 // sphincter's and the positive part of a lid's, the others are dead loads). The field
 // is conservative: a linear muscle's pull is a dead load along the rest
 // direction u0 from the node to A (tangent to the skin for a muscle along
-// the bone), potential -t sense w (p - p0) . u0 (a
+// the bone, from the key point for mentalis), potential -t sense w (p - p0) . u0 (a
 // push away from a moving point would be unstable across the fibre); a
 // sphincter's, contracting (t sense > 0), t sense w h(|d.xy|) with d the
 // node's offset from the epicentre, h(r) = r beyond the floor b / 3 and
