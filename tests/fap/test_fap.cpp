@@ -1140,11 +1140,11 @@ TEST(FapSynthesis, SongsLidsCloseOverTheEyeballInBetweenTargetsIncluded) {
 }
 
 // Joy on the generated 3k head, simulated on 1,500 vertices, folds the
-// cheeks over (0.048 % of the skin's area turned) where the zygomatici act.
-// Only the muscles to blame are reduced: risorius, the eye sphincters and
-// the jaw keep the table's contraction, and the target is that pose. (Until
-// the zygomatici pulled along the skin's surface, the fold was 0.093 % and
-// the eye sphincters were blamed too.)
+// cheeks over where the zygomatici act. Only the muscles to blame are
+// reduced: risorius, the eye sphincters and the jaw keep the table's
+// contraction, and the target is that pose. (Until zygomaticus major pulled
+// along the skin's surface, 0.093 % of the skin's area turned, 0.048 %
+// after, and the eye sphincters were blamed too.)
 // (This was the 2k head on 1,000 vertices until the generator got lid rows;
 // no expression of the 1k or 2k heads on 1,000 simulation vertices, or of
 // Song, tears now.)
