@@ -150,8 +150,8 @@ double muscle_load(const SkinModel &skin, const Muscle &m, double tension, const
 
 // How far the muscle has acted at positions X (model units, positive in the
 // direction of its action): linear, the insertion's motion along its pull
-// direction u0 (the fibre toward the attachment, or its tangent part) times
-// sense; sphincter, the calibrated semi-axis
+// direction u0 (toward the attachment's node or key point, or the tangent
+// part of the former: MuscleDef::line) times sense; sphincter, the calibrated semi-axis
 // node's motion toward the epicentre in the x-y plane; lid, the margin
 // node's arc about the axis toward the other lid. When `gradient` is
 // given, adds the action's gradient with respect to X (4n x 3) to it.
