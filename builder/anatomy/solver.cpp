@@ -932,6 +932,12 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
                                " (it reached " + number(action) + " at " + number(kUnreachable) +
                                " times the linear estimate of the tension)");
       }
+      // The clamp halves a tension whose load moves the action the wrong
+      // way at every step: fallen to 1/kUnreachable of its start, it will
+      // not turn (Song's FAP 64 beyond its range: 40 iterations of halving).
+      if (t_new < t_ref / kUnreachable)
+        return done(false, name + ": the load moves the controlled action the wrong way (the tension fell to " +
+                               number(t_new / t_ref) + " of its start)");
       dt = t_new - t;
       t = t_new;
       dx = u + dt * w;

@@ -72,7 +72,10 @@
 // equation: action(X) = value. Each Newton step is the bordered one: with
 // u = K^-1 r and w = K^-1 g (g the unit load), t moves by dt such that the
 // linearised action of X + u + dt w meets the value, and the step is
-// u + dt w (t grows at most fourfold per step, since the tissue stiffens).
+// u + dt w (t grows at most fourfold per step, since the tissue stiffens,
+// and falls at most by half). The solve fails when t would pass 50 times its
+// first estimate (the tissue locks: LoadControl::unreachable), or fall below
+// 1/50 of it, or below zero (the load moves the action the wrong way).
 // With max_tension, t stops there and the solve finishes at that load.
 // The newton solvers only.
 //

@@ -536,6 +536,12 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         std::string beyond_why;  // why the group stayed within its range
         if (pz && capped && skin_faults(model, pose_epidermis(model, *pz)).any()) {
           beyond_why = "the skin folds or sinks into the skull already at them";
+        } else if (pz && capped && action(pz->X, nullptr) <= 0) {
+          // The load control steers an action that grows with the load; one
+          // that fell at the range cannot be steered past it (Song's FAP 17:
+          // 40 Newton iterations, then a failed solve, 2.4 s of 34 s on one
+          // worker).
+          beyond_why = "beyond them nothing is tried: at them the FDP moves the wrong way";
         } else if (pz && capped) {
           SteerFrom from;
           from.pose = &*pz;

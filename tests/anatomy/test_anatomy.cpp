@@ -981,6 +981,36 @@ TEST(Solver, NeverReportsAnUnconvergedResultAsConverged) {
   EXPECT_TRUE(X.allFinite());
 }
 
+TEST(Solver, ALoadThatMovesTheActionTheWrongWayFailsAtOnce) {
+  // Load control from a tension already found (a solve beyond a FAP's
+  // range starts so): the step clamp halves the tension each iteration
+  // while the load pulls the action the other way. Without the guard the
+  // solve ran until the stall rule, 60 iterations.
+  const FaceModel &m = head_1k().model;
+  const Muscle &mu = m.muscles[static_cast<size_t>(m.find("zygomaticus_major_left"))];
+  LoadControl control;
+  control.unit_load = [&](const Eigen::MatrixXd &X, Eigen::MatrixXd *F, NodeBlocks *K) {
+    return muscle_load(m.tissue, mu, 1.0, X, F, K);
+  };
+  // The muscle's own action, negated: the load lowers it.
+  control.action = [&](const Eigen::MatrixXd &X, Eigen::MatrixXd *gradient) {
+    Eigen::MatrixXd g = Eigen::MatrixXd::Zero(X.rows(), 3);
+    const double a = muscle_action(m.tissue, mu, X, &g);
+    if (gradient) *gradient -= g;
+    return -a;
+  };
+  control.value = 100 * m.solver.tolerance;
+  control.tension = 0.05;
+  Eigen::MatrixXd X = m.tissue.X0;
+  FactorCache cache;
+  SolveStats st = solve_equilibrium(m.tissue, all_vertices(m.tissue), ForceField(), m.tissue.X0, X, m.solver, &cache,
+                                    &control);
+  EXPECT_FALSE(st.converged);
+  EXPECT_NE(st.message.find("wrong way"), std::string::npos) << st.message;
+  EXPECT_LE(st.iterations, 10) << st.message;
+  EXPECT_TRUE(X.allFinite());
+}
+
 TEST(BadInput, NotAFaceFlippedOrMissingFdps) {
   const Built &b = head_1k();
   // Flipped triangles: the skin faces inward.
