@@ -746,7 +746,9 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
   Vec g, u, w, cgrad;
   double t = control ? std::max(control->tension, 0.0) : 0.0;
   // Load control gives up once the tension passes this multiple of its
-  // first estimate (the linear one from rest): the tissue has locked.
+  // first estimate (the linear one from rest, or the tension it starts
+  // from): the tissue has locked; or falls below its inverse: the load
+  // moves the action the wrong way.
   constexpr double kUnreachable = 50;
   double t_ref = t;
   Eigen::MatrixXd Ac;
@@ -933,8 +935,8 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
                                " times the linear estimate of the tension)");
       }
       // The clamp halves a tension whose load moves the action the wrong
-      // way at every step: fallen to 1/kUnreachable of its start, it will
-      // not turn (Song's FAP 64 beyond its range: 40 iterations of halving).
+      // way at every step: fallen that far, it will not turn (Song's FAP 64
+      // beyond its range: 40 iterations of halving).
       if (t_new < t_ref / kUnreachable)
         return done(false, name + ": the load moves the controlled action the wrong way (the tension fell to " +
                                number(t_new / t_ref) + " of its start)");

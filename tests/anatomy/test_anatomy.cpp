@@ -984,8 +984,8 @@ TEST(Solver, NeverReportsAnUnconvergedResultAsConverged) {
 TEST(Solver, ALoadThatMovesTheActionTheWrongWayFailsAtOnce) {
   // Load control from a tension already found (a solve beyond a FAP's
   // range starts so): the step clamp halves the tension each iteration
-  // while the load pulls the action the other way. Without the guard the
-  // solve ran until the stall rule, 60 iterations.
+  // while the load pulls the action the other way; the guard ends the solve
+  // once it has fallen to 1/50 (switched off, both checks below fail).
   const FaceModel &m = head_1k().model;
   const Muscle &mu = m.muscles[static_cast<size_t>(m.find("zygomaticus_major_left"))];
   LoadControl control;
