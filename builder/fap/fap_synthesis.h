@@ -52,7 +52,11 @@
 // moves the wrong way at s = 1: the load control steers an action that grows
 // with the load); its pose is kept
 // if the skin stays a face (face_model.h, skin_faults: no skin triangle
-// turned over, nothing below the skull), else the pose at s = 1 is. A group that cannot reach the reference makes
+// turned over, nothing below the skull); where it does not, a pose short of
+// the fold that does (one more solve, to 3/4 of the way along which the
+// chord between the two poses keeps the skin a face; not for a group that
+// moves its FDP less than a FAP unit at s = 1); failing that, the pose at
+// s = 1. A group that cannot reach the reference makes
 // its target at that cap and keeps the table's reference: the target
 // under-reaches (the outcome says by how much and why), and a stream at the
 // reference shows the muscles at their most. (Lowering the reference to

@@ -110,7 +110,8 @@ const Built &head_1k() {
   static std::unique_ptr<Built> b;
   if (!b) {
     FaceModelOptions fo;
-    fo.calibrate_only = {"zygomaticus_major_left", "depressor_anguli_left", "frontalis_major_left", "corrugator_left"};
+    fo.calibrate_only = {"zygomaticus_major_left", "depressor_anguli_left", "frontalis_major_left", "corrugator_left",
+                         "mentalis_left", "mentalis_right"};
     b = afmtest::build_reference_model(1000, fo);
   }
   return *b;
@@ -513,6 +514,66 @@ TEST(FapSynthesis, AWeakGroupPassesItsRangeUpToTheCap) {
     }
   }
   EXPECT_TRUE(beyond);
+}
+
+// A group whose pose at the reference, beyond its range, folds the skin
+// stops short of the fold, at a scale whose pose keeps the skin a face:
+// mentalis lowering the 1k head's chin (FAP 18) reaches 11 % of the
+// reference at its range and folds the skin where it reaches all of it.
+TEST(FapSynthesis, AGroupThatFoldsBeyondItsRangeStopsShortOfTheFold) {
+  const Built &b = head_1k();
+  const FaceModel &m = b.model;
+  const SkinModel &s = m.tissue;
+  FapSynthesisOptions o;
+  o.only = {18};
+  o.negative_sides = false;
+  Expected<FapSynthesis> syn = synthesize_faps(b.head.scene, m, o);
+  ASSERT_TRUE(syn.is_ok()) << syn.status().message();
+  ASSERT_EQ(syn->outcomes.size(), 1u);
+  const FapOutcome &out = syn->outcomes[0];
+  ASSERT_TRUE(out.made) << out.message;
+  ASSERT_EQ(syn->targets.size(), 1u);
+  EXPECT_GT(out.scale, 1.0);
+  EXPECT_LT(out.scale, kMaxFapScale);
+  EXPECT_LT(out.reached, 1.0);
+  EXPECT_NE(out.message.find("times them the skin folds"), std::string::npos) << out.message;
+  const Eigen::MatrixXd D = syn->targets[0].displacement[static_cast<size_t>(m.skin)];
+  EXPECT_FALSE(skin_faults(m, s.X0.topRows(s.n) + D).any());
+
+  // Independently: the table's contractions move the FDP less, and the pose
+  // that reaches the reference folds the skin.
+  const afm_fap_info *info = afm_fap(18);
+  const FdpPoint *fdp = m.fdps.find(FdpId{info->fdp_group, info->fdp_index}, m.skin);
+  ASSERT_TRUE(fdp && fdp->vertex >= 0);
+  const Eigen::Vector3d dir = direction_of(18);
+  const int node = s.node(kEpidermis, fdp->vertex);
+  PoseAction action = [&s, node, dir](const Eigen::MatrixXd &X, Eigen::MatrixXd *g) {
+    if (g) g->row(node) += dir.transpose();
+    return (X.row(node) - s.X0.row(node)).dot(dir.transpose());
+  };
+  const std::vector<std::pair<int, double>> pattern = {{m.find("mentalis_left"), 100.0},
+                                                       {m.find("mentalis_right"), 100.0}};
+  ASSERT_GE(pattern[0].first, 0);
+  ASSERT_GE(pattern[1].first, 0);
+  Activation a;
+  a.muscles = pattern;
+  FactorCache cache;
+  Expected<Pose> at_one = solve_pose(m, a, &cache);
+  ASSERT_TRUE(at_one.is_ok()) << at_one.status().message();
+  const double along_one = action(at_one->X, nullptr), along = D.row(fdp->vertex).dot(dir.transpose());
+  EXPECT_GT(along, 2 * along_one);
+  const double value = 300 * fapu_distance(m.fapu, info->unit) / 1024.0;
+  EXPECT_LT(along, value);
+  SteerFrom from;
+  from.pose = &*at_one;
+  from.scale = 1;
+  from.max_iterations = 40;
+  double scale = 0;
+  bool capped = false;
+  Expected<Pose> reaching = solve_pose_to(m, pattern, action, value, &cache, &scale, kMaxFapScale, &capped, &from);
+  ASSERT_TRUE(reaching.is_ok()) << reaching.status().message();
+  EXPECT_GT(scale, out.scale);
+  EXPECT_TRUE(skin_faults(m, pose_epidermis(m, *reaching)).any());
 }
 
 TEST(FapSynthesis, AMissingMuscleIsAReportNotAnError) {
