@@ -576,12 +576,12 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
             beyond_why = "beyond it the skin folds or sinks into the skull";
             if (action(pz->X, nullptr) >= unit) {
               const Eigen::MatrixXd E1 = pose_epidermis(model, *pz), E2 = pose_epidermis(model, *beyond);
-              double share = 1;
-              while (share > 1.0 / kChordSteps && skin_faults(model, E1 + share * (E2 - E1)).any())
-                share -= 1.0 / kChordSteps;
+              int steps = kChordSteps;  // of the chord that stay a face, at most
+              while (steps > 1 && skin_faults(model, E1 + (steps * 1.0 / kChordSteps) * (E2 - E1)).any()) --steps;
+              const double share = kChordShare * steps / kChordSteps;
               double s3 = 0;
               bool capped3 = false;
-              Expected<Pose> p = past_range(scale + kChordShare * share * (s2 - scale), &s3, &capped3);
+              Expected<Pose> p = past_range(scale + share * (s2 - scale), &s3, &capped3);
               if (p && !skin_faults(model, pose_epidermis(model, *p)).any()) {
                 pz = std::move(p);
                 scale = cap = s3;
