@@ -117,6 +117,7 @@ Input build(const std::string &name, const Scene &scene, const FdpSet &fdps, int
   const double t_model = since(t0);
   FapSynthesisOptions so;
   so.threads = threads;
+  so.sim = &model->sim;
   so.progress = [](int d, int n, const std::string &w) { progress("targets", d, n, w); };
   Expected<FapSynthesis> syn = synthesize_faps(model->scene, model->model, so);
   if (!syn) die(name + ": " + syn.status().message());

@@ -72,7 +72,9 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
   {
     const double t2 = now();
     Expected<SimFaceModel> s = build_sim_face_model(scene, fdps, SimMeshOptions{kDefaultSimVertices}, FaceModelOptions{});
-    Expected<FapSynthesis> st = s ? synthesize_faps(s->scene, s->model) : Expected<FapSynthesis>(s.status());
+    FapSynthesisOptions so;
+    if (s) so.sim = &s->sim;
+    Expected<FapSynthesis> st = s ? synthesize_faps(s->scene, s->model, so) : Expected<FapSynthesis>(s.status());
     if (st) {
       lift_synthesis(*st, s->sim);
       size_t under = 0;

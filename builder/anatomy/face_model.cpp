@@ -501,29 +501,47 @@ Pose superposed_pose(const FaceModel &model, const Activation &a) {
   return out;
 }
 
+namespace {
+
+Eigen::Vector3d face_normal(const Eigen::MatrixXd &X, const Eigen::MatrixXi &F, Eigen::Index f) {
+  const Eigen::Vector3d a = X.row(F(f, 0)), b = X.row(F(f, 1)), c = X.row(F(f, 2));
+  return (b - a).cross(c - a);
+}
+
+}  // namespace
+
+std::vector<int> turned_faces(const Eigen::MatrixXd &V0, const Eigen::MatrixXi &F, const Eigen::MatrixXd &V,
+                              double *share) {
+  double total = 0;
+  for (Eigen::Index f = 0; f < F.rows(); ++f) total += face_normal(V0, F, f).norm();
+  const double mean = total / std::max<double>(1, static_cast<double>(F.rows()));
+  std::vector<int> out;
+  double turned = 0;
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    const Eigen::Vector3d n0 = face_normal(V0, F, f);
+    if (n0.norm() > 1e-3 * mean && n0.dot(face_normal(V, F, f)) <= 0) {
+      out.push_back(static_cast<int>(f));
+      turned += n0.norm();
+    }
+  }
+  if (share) *share = total > 0 ? turned / total : 0;
+  return out;
+}
+
 SkinFaults skin_faults(const FaceModel &model, const Eigen::MatrixXd &E) {
   const SkinModel &s = model.tissue;
   SkinFaults out;
-  auto normal = [&s](const Eigen::MatrixXd &X, Eigen::Index f) {
-    const Eigen::Vector3d a = X.row(s.F(f, 0)), b = X.row(s.F(f, 1)), c = X.row(s.F(f, 2));
-    return Eigen::Vector3d((b - a).cross(c - a));
-  };
-  double total = 0;
-  for (Eigen::Index f = 0; f < s.F.rows(); ++f) total += normal(s.X0, f).norm();
-  const double mean = total / std::max<double>(1, static_cast<double>(s.F.rows()));
-  double turned = 0, stretched = 0;
+  const Eigen::MatrixXd X0 = s.X0.topRows(s.n);
+  out.turned_faces = turned_faces(X0, s.F, E, &out.turned_share);
+  double total = 0, stretched = 0;
   for (Eigen::Index f = 0; f < s.F.rows(); ++f) {
-    const Eigen::Vector3d n0 = normal(s.X0, f), n = normal(E, f);
-    if (n0.norm() > 1e-3 * mean && n0.dot(n) <= 0) {
-      out.turned_faces.push_back(static_cast<int>(f));
-      turned += n0.norm();
-    }
-    if (n.norm() > kTearStretch * n0.norm()) {
+    const double a0 = face_normal(X0, s.F, f).norm();
+    total += a0;
+    if (face_normal(E, s.F, f).norm() > kTearStretch * a0) {
       out.stretched_faces.push_back(static_cast<int>(f));
-      stretched += n0.norm();
+      stretched += a0;
     }
   }
-  out.turned_share = total > 0 ? turned / total : 0;
   out.stretched_share = total > 0 ? stretched / total : 0;
   std::vector<char> on_jaw(static_cast<size_t>(s.n), 0);
   for (int v : model.jaw.vertices) on_jaw[static_cast<size_t>(v)] = 1;

@@ -181,18 +181,34 @@ Pose superposed_pose(const FaceModel &model, const Activation &activation);
 // left upper lid off the eyeball: 3.4e-3 stretched, 5.7e-3 turned).
 constexpr double kTearStretch = 3;
 constexpr double kTornShare = 1e-4;
+//
+// A model built on a simulation mesh (sim_mesh.h) stores its targets on the
+// input's own skin, lifted from the coarse one; that skin can fold where the
+// coarse one does not (a fine triangle steeper than the coarse one it is
+// bound to, as the coarse one turns). skin_faults leaves `lifted_*` empty;
+// fap_synthesis fills them (lifted_turned_faces).
 struct SkinFaults {
   std::vector<int> turned_faces;      // skin triangles, ascending
   std::vector<int> stretched_faces;   // skin triangles, ascending
   std::vector<int> sunk_vertices;     // skin vertices, ascending
+  std::vector<int> lifted_turned_faces;  // the input skin's triangles, ascending
   double turned_share = 0;            // rest area of turned_faces over the skin's, 0..1
   double stretched_share = 0;         // rest area of stretched_faces over the skin's, 0..1
-  bool any() const { return !turned_faces.empty() || !sunk_vertices.empty(); }
+  double lifted_turned_share = 0;     // the same of lifted_turned_faces on the input skin
+  bool any() const { return !turned_faces.empty() || !sunk_vertices.empty() || !lifted_turned_faces.empty(); }
   bool tears() const {
-    return !sunk_vertices.empty() || turned_share > kTornShare || stretched_share > kTornShare;
+    return !sunk_vertices.empty() || turned_share > kTornShare || stretched_share > kTornShare ||
+           lifted_turned_share > kTornShare;
   }
 };
 SkinFaults skin_faults(const FaceModel &model, const Eigen::MatrixXd &E);
+
+// The triangles F (#F x 3) that turn over from V0 to V (#V x 3 each): their
+// normal at V points against the one at V0. Triangles under a thousandth of
+// the mean rest area are left out (slivers whose rest normal is noise).
+// Ascending; *share, when given, gets their rest area over the total, 0..1.
+std::vector<int> turned_faces(const Eigen::MatrixXd &V0, const Eigen::MatrixXi &F, const Eigen::MatrixXd &V,
+                              double *share = nullptr);
 
 // The signed tension of muscle i at `percent` contraction.
 double muscle_tension(const Muscle &m, double percent);

@@ -283,6 +283,8 @@ Expected<SimMesh> make_sim_mesh(const Scene &scene, const FdpSet &fdps, const Si
   auto identity = [&] {
     SimMesh sim = identity_sim(skin, skin_index);
     sim.binding = bind_fine_to_coarse(skin, sim);
+    sim.skin_V = skin.V;
+    sim.skin_F = skin.F;
     sim.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return sim;
   };
@@ -428,6 +430,8 @@ Expected<SimMesh> make_sim_mesh(const Scene &scene, const FdpSet &fdps, const Si
   sim.F.resize(static_cast<Eigen::Index>(tris.size()), 3);
   for (size_t f = 0; f < tris.size(); ++f) sim.F.row(static_cast<Eigen::Index>(f)) = tris[f].transpose();
   sim.binding = bind_fine_to_coarse(skin, sim);
+  sim.skin_V = skin.V;
+  sim.skin_F = skin.F;
   sim.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return sim;
 }
@@ -529,6 +533,10 @@ Expected<SimFaceModel> build_sim_face_model(const Scene &scene, const FdpSet &fd
 Eigen::MatrixXd lift_displacement(const SimMesh &sim, const Eigen::MatrixXd &Dc) {
   if (Dc.rows() == 0) return Dc;
   return carried_displacement(sim.binding, Dc);
+}
+
+std::vector<int> lifted_turned_faces(const SimMesh &sim, const Eigen::MatrixXd &Dc, double *share) {
+  return turned_faces(sim.skin_V, sim.skin_F, sim.skin_V + lift_displacement(sim, Dc), share);
 }
 
 }  // namespace afmb

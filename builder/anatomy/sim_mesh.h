@@ -73,6 +73,8 @@ struct SimMesh {
   Eigen::MatrixXi F;        // #Fc x 3 coarse triangles into V, counter-clockwise from outside
   std::vector<int> kept;    // #Vc: the skin vertex each coarse vertex is
   SkinBinding binding;      // #V rows: each skin vertex's coarse triangle and weights
+  Eigen::MatrixXd skin_V;   // #V x 3 the skin's own rest positions, model units
+  Eigen::MatrixXi skin_F;   // #F x 3 the skin's own triangles into skin_V
   double seconds = 0;       // time taken
 };
 
@@ -94,6 +96,14 @@ FdpSet lift_fdps(const FdpSet &coarse, const SimMesh &sim);
 
 // The skin displacement (#V x 3) carried from a coarse one (#Vc x 3).
 Eigen::MatrixXd lift_displacement(const SimMesh &sim, const Eigen::MatrixXd &Dc);
+
+// The skin's own triangles that a coarse displacement Dc (#Vc x 3), lifted,
+// turns over (face_model.h, turned_faces); *share: their rest area over the
+// skin's. A fine triangle can turn where no coarse one does: its corners
+// move as the points of the coarse surface they are bound to, so a fine
+// triangle steep against its coarse one is squashed flat, then over, as the
+// coarse one turns (Song's lips pushed back, FAP 16 negative).
+std::vector<int> lifted_turned_faces(const SimMesh &sim, const Eigen::MatrixXd &Dc, double *share = nullptr);
 
 // The skin vertices whose nodes the muscles' key points map to on the skin
 // itself (muscles.h: attachments to the skull layer, insertions to the

@@ -48,28 +48,40 @@ std::string other_side(const std::string &name) {
 // sunk vertex or a corner of the largest turned or stretched triangles, as
 // many as leave the rest of each under kTornShare (the slivers a smile turns
 // at the mouth corners blame nothing), with their other side's twin, so
-// that a reduced expression stays symmetric.
-std::vector<char> blame(const FaceModel &model, const Activation &a, const SkinFaults &faults) {
+// that a reduced expression stays symmetric. A turned triangle of the lifted
+// skin stands for the coarse vertices its corners are bound to (`sim`).
+std::vector<char> blame(const FaceModel &model, const Activation &a, const SkinFaults &faults, const SimMesh *sim) {
   const SkinModel &skin = model.tissue;
-  auto area = [&skin](int f) {
-    const Eigen::Vector3d p = skin.X0.row(skin.F(f, 0)), q = skin.X0.row(skin.F(f, 1)), r = skin.X0.row(skin.F(f, 2));
-    return (q - p).cross(r - p).norm();
-  };
-  double total = 0;
-  for (Eigen::Index f = 0; f < skin.F.rows(); ++f) total += area(static_cast<int>(f));
   std::vector<char> hit(static_cast<size_t>(skin.n), 0);
-  for (const std::vector<int> *faces : {&faults.turned_faces, &faults.stretched_faces}) {
-    std::vector<int> order = *faces;
+  // `faces` of (V, F), largest first, until the rest is under kTornShare;
+  // `mark` takes each one's corners.
+  auto take = [](const std::vector<int> &faces, const Eigen::MatrixXd &V, const Eigen::MatrixXi &F,
+                 const std::function<void(int)> &mark) {
+    auto area = [&](int f) {
+      const Eigen::Vector3d p = V.row(F(f, 0)), q = V.row(F(f, 1)), r = V.row(F(f, 2));
+      return (q - p).cross(r - p).norm();
+    };
+    double total = 0;
+    for (Eigen::Index f = 0; f < F.rows(); ++f) total += area(static_cast<int>(f));
+    std::vector<int> order = faces;
     std::stable_sort(order.begin(), order.end(), [&area](int f, int g) { return area(f) > area(g); });
     double rest = 0;  // twice the area left unblamed
     for (int f : order) rest += area(f);
     for (int f : order) {
       if (rest <= kTornShare * total) break;
-      for (int k = 0; k < 3; ++k) hit[static_cast<size_t>(skin.F(f, k))] = 1;
+      for (int k = 0; k < 3; ++k) mark(F(f, k));
       rest -= area(f);
     }
-  }
-  for (int v : faults.sunk_vertices) hit[static_cast<size_t>(v)] = 1;
+  };
+  const Eigen::MatrixXd X0 = skin.X0.topRows(skin.n);
+  auto mark = [&hit](int v) { hit[static_cast<size_t>(v)] = 1; };
+  take(faults.turned_faces, X0, skin.F, mark);
+  take(faults.stretched_faces, X0, skin.F, mark);
+  for (int v : faults.sunk_vertices) mark(v);
+  if (sim)
+    take(faults.lifted_turned_faces, sim->skin_V, sim->skin_F, [&](int v) {
+      for (int j = 0; j < 3; ++j) mark(sim->binding.corner(v, j));
+    });
   std::vector<char> out(a.muscles.size() + 1, 0);
   auto any_hit = [&hit](const std::vector<int> &vertices) {
     for (int v : vertices)
@@ -219,6 +231,14 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
   if (model.skin < 0 || model.tissue.n == 0) return Status::error("FAP synthesis: the model has no skin");
   const SkinModel &skin = model.tissue;
   FapSynthesis out;
+  // What is wrong with an epidermis as a face: on the model's skin, and on
+  // the input's once lifted.
+  const SimMesh *sim = options.sim && options.sim->decimated ? options.sim : nullptr;
+  auto face_faults = [&model, &skin, sim](const Eigen::MatrixXd &E) {
+    SkinFaults f = skin_faults(model, E);
+    if (sim) f.lifted_turned_faces = lifted_turned_faces(*sim, E - skin.X0.topRows(skin.n), &f.lifted_turned_share);
+    return f;
+  };
 
   // The work list: a FAP's mapping and side, or a viseme's or an
   // expression's.
@@ -320,7 +340,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       // muscles to blame that does not, by bisection; of every muscle and
       // the jaw when that fails.
       auto torn = [&](const Pose &p, SkinFaults *faults = nullptr) {
-        SkinFaults f = skin_faults(model, pose_epidermis(model, p));
+        SkinFaults f = face_faults(pose_epidermis(model, p));
         const bool bad = f.tears();
         if (faults) *faults = std::move(f);
         return bad;
@@ -347,7 +367,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
           if (!kept) return std::nullopt;
           return std::make_pair(lo, std::move(*kept));
         };
-        const std::vector<char> blamed = blame(model, a, faults);
+        const std::vector<char> blamed = blame(model, a, faults, sim);
         std::optional<std::pair<double, Pose>> found;
         if (blamed != all && std::count(blamed.begin(), blamed.end(), 1) > 0) {
           found = bisect(blamed);
@@ -540,7 +560,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         Expected<Pose> pz = solve_pose_to(model, pattern, action, value, &cache, &scale, cap, &capped,
                                           first.pose ? &first : nullptr);
         std::string beyond_why;  // why the group stayed within its range
-        if (pz && capped && skin_faults(model, pose_epidermis(model, *pz)).any()) {
+        if (pz && capped && face_faults(pose_epidermis(model, *pz)).any()) {
           beyond_why = "the skin folds or sinks into the skull already at them";
         } else if (pz && capped && action(pz->X, nullptr) <= 0) {
           // The load control steers an action that grows with the load; one
@@ -562,7 +582,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
           Expected<Pose> beyond = past_range(kMaxFapScale, &s2, &capped2);
           if (!beyond) {
             beyond_why = "beyond it the solve fails";
-          } else if (skin_faults(model, pose_epidermis(model, *beyond)).any()) {
+          } else if (face_faults(pose_epidermis(model, *beyond)).any()) {
             // Short of the fold there may be a face. Where the chord from
             // the pose at s = 1 to the folding one first folds guesses where
             // the poses between do; one solve goes to 3/4 of that share of
@@ -577,12 +597,12 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
             if (action(pz->X, nullptr) >= unit) {
               const Eigen::MatrixXd E1 = pose_epidermis(model, *pz), E2 = pose_epidermis(model, *beyond);
               int steps = kChordSteps;  // of the chord that stay a face, at most
-              while (steps > 1 && skin_faults(model, E1 + (steps * 1.0 / kChordSteps) * (E2 - E1)).any()) --steps;
+              while (steps > 1 && face_faults(E1 + (steps * 1.0 / kChordSteps) * (E2 - E1)).any()) --steps;
               const double share = kChordShare * steps / kChordSteps;
               double s3 = 0;
               bool capped3 = false;
               Expected<Pose> p = past_range(scale + share * (s2 - scale), &s3, &capped3);
-              if (p && !skin_faults(model, pose_epidermis(model, *p)).any()) {
+              if (p && !face_faults(pose_epidermis(model, *p)).any()) {
                 pz = std::move(p);
                 scale = cap = s3;
                 char why[96];
@@ -776,8 +796,13 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
                      "'s too: each moves it by a share, measured together at the same value";
     }
   }
+  const Eigen::MatrixXd rest = skin.X0.topRows(skin.n);
   for (Result &r : results) {
-    if (r.target) out.targets.push_back(std::move(*r.target));
+    if (r.target) {
+      const Eigen::MatrixXd &D = r.target->displacement[static_cast<size_t>(model.skin)];
+      r.outcome.turned = static_cast<int>(turned_faces(rest, skin.F, rest + D).size());
+      out.targets.push_back(std::move(*r.target));
+    }
     if (r.control) out.jaw.controls.push_back(*r.control);
     if (r.glide) out.jaw.controls.push_back(*r.glide);
     out.outcomes.push_back(std::move(r.outcome));
@@ -800,6 +825,7 @@ void lift_synthesis(FapSynthesis &synthesis, const SimMesh &sim) {
     if (skin >= t.displacement.size() || t.displacement[skin].rows() == 0) continue;
     t.controls = t.displacement[skin];
     t.displacement[skin] = lift_displacement(sim, t.controls);
+    o.turned = static_cast<int>(turned_faces(sim.skin_V, sim.skin_F, sim.skin_V + t.displacement[skin]).size());
     if (o.kind != AFM_TARGET_FAP) o.largest = t.displacement[skin].rowwise().norm().maxCoeff();
   }
 }

@@ -52,7 +52,8 @@
 // moves the wrong way at s = 1: the load control steers an action that grows
 // with the load); its pose is kept
 // if the skin stays a face (face_model.h, skin_faults: no skin triangle
-// turned over, nothing below the skull); where it does not, a pose short of
+// turned over, nothing below the skull; on a simulation mesh, none of the
+// lifted skin's either: FapSynthesisOptions::sim); where it does not, a pose short of
 // the fold that does (one more solve, to 3/4 of the way along which the
 // chord between the two poses keeps the skin a face; not for a group that
 // moves its FDP less than a FAP unit at s = 1); failing that, the pose at
@@ -107,6 +108,8 @@ struct FapOutcome {
   double scale = 0;               // muscle groups: the factor on the table's contractions;
                                   // visemes and expressions: on the muscles the message
                                   // names (1: the table's pose)
+  int turned = 0;                 // skin triangles the target turns over (turned_faces), on
+                                  // the input's skin once lifted (lift_synthesis)
   int dynamic = 0;                // vertices solved
   double seconds = 0;
 };
@@ -120,6 +123,11 @@ struct FapSynthesisOptions {
   bool negative_sides = true;     // make the negative side's own target where the table has one
   // Workers (0: one per core). The targets are the same for any number.
   int threads = 0;
+  // The simulation mesh the model was built on (sim_mesh.h), when it is
+  // decimated: the skin the targets are lifted to may not fold either
+  // (SkinFaults::lifted_turned_faces). Not owned; null: the model's skin is
+  // the input's.
+  const SimMesh *sim = nullptr;
   // Called after each target: done of total, and which (from the workers,
   // one call at a time).
   std::function<void(int done, int total, const std::string &what)> progress;

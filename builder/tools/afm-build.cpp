@@ -405,6 +405,7 @@ int main(int argc, char **argv) {
     const auto t1 = std::chrono::steady_clock::now();
     if (!quiet) so.progress = progress_line;
     so.threads = fo.threads;
+    so.sim = sim;
     Expected<FapSynthesis> syn = synthesize_faps(scene, *model, so);
     if (!syn) return fail(syn.status());
     lift_synthesis(*syn, *sim);

@@ -1200,6 +1200,78 @@ TEST(FapSynthesis, SongsLidsCloseOverTheEyeballInBetweenTargetsIncluded) {
   }
 }
 
+// A target made on a simulation mesh is stored on the input's skin, lifted
+// (sim_mesh.h), and that skin can fold where the coarse one does not:
+// Song's lips pushed back (FAP 16's negative side) passed their range to
+// the reference with the coarse skin whole and the lifted one folded. Given
+// the simulation mesh, the synthesis stops short of that fold as it does
+// of a coarse one (fap_synthesis.h).
+TEST(FapSynthesis, ATargetMadeOnASimulationMeshDoesNotFoldTheLiftedSkin) {
+  AFM_REQUIRE_SHARED_DATA();
+  const SongOnSimMesh song = song_on_sim_mesh({"orbicularis_oris"});
+  ASSERT_FALSE(HasFailure());
+  const SimFaceModel &sm = song.built;
+  ASSERT_TRUE(sm.sim.decimated);
+  const Part &part = song.face.scene.parts[static_cast<size_t>(sm.sim.skin)];
+  // Input skin triangles (of at least a thousandth of the mean area) that
+  // displacement D (#V x 3) turns against their rest normal.
+  auto normal = [&part](const Eigen::MatrixXd &X, Eigen::Index f) {
+    const Eigen::Vector3d a = X.row(part.F(f, 0)), b = X.row(part.F(f, 1)), c = X.row(part.F(f, 2));
+    return Eigen::Vector3d((b - a).cross(c - a));
+  };
+  double mean = 0;
+  for (Eigen::Index f = 0; f < part.F.rows(); ++f) mean += normal(part.V, f).norm() / static_cast<double>(part.F.rows());
+  auto turned = [&](const Eigen::MatrixXd &D) {
+    int n = 0;
+    for (Eigen::Index f = 0; f < part.F.rows(); ++f) {
+      const Eigen::Vector3d n0 = normal(part.V, f);
+      if (n0.norm() > 1e-3 * mean && n0.dot(normal(part.V + D, f)) <= 0) ++n;
+    }
+    return n;
+  };
+  struct Made {
+    FapOutcome outcome;
+    MorphTarget target;
+  };
+  auto pushed_back = [&](const SimMesh *sim) {
+    FapSynthesisOptions o;
+    o.only = {16};
+    o.sim = sim;
+    Expected<FapSynthesis> syn = synthesize_faps(sm.scene, sm.model, o);
+    EXPECT_TRUE(syn.is_ok()) << syn.status().message();
+    Made m;
+    if (!syn.is_ok()) return m;
+    lift_synthesis(*syn, sm.sim);
+    size_t next = 0;
+    for (const FapOutcome &out : syn->outcomes) {
+      if (!out.made) continue;
+      if (out.side < 0) m = {out, syn->targets[next]};
+      ++next;
+    }
+    EXPECT_TRUE(m.outcome.made) << "FAP 16's negative side is not made";
+    return m;
+  };
+  const size_t skin = static_cast<size_t>(sm.sim.skin);
+  const Made blind = pushed_back(nullptr), seeing = pushed_back(&sm.sim);
+  ASSERT_FALSE(HasFailure());
+  ASSERT_EQ(blind.target.displacement[skin].rows(), part.V.rows());
+  ASSERT_EQ(seeing.target.displacement[skin].rows(), part.V.rows());
+  // Blind to the lifted skin: the coarse skin whole, the lifted one folded.
+  const Eigen::MatrixXd coarse_rest = sm.model.tissue.X0.topRows(sm.model.tissue.n);
+  EXPECT_FALSE(skin_faults(sm.model, coarse_rest + blind.target.controls).any());
+  const int blind_turned = turned(blind.target.displacement[skin]);
+  EXPECT_GT(blind_turned, 0);
+  EXPECT_EQ(blind.outcome.turned, blind_turned);
+  // Seeing it: short of the fold, still past the range.
+  EXPECT_EQ(turned(seeing.target.displacement[skin]), 0);
+  EXPECT_EQ(seeing.outcome.turned, 0);
+  EXPECT_GT(seeing.outcome.scale, 1);
+  EXPECT_LT(seeing.outcome.reached, blind.outcome.reached);
+  std::printf("FAP 16 (negative): blind to the lifted skin %.0f %% reached, %d triangles turned; seeing it %.0f %% "
+              "at %.2f times the table's contractions\n",
+              100 * blind.outcome.reached, blind_turned, 100 * seeing.outcome.reached, seeing.outcome.scale);
+}
+
 // Joy on the generated 3k head, simulated on 1,500 vertices, folds the
 // cheeks over where the zygomatici act. Only the muscles to blame are
 // reduced: risorius, the eye sphincters and the jaw keep the table's
