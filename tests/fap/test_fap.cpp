@@ -131,6 +131,24 @@ const FapSynthesis &synthesis() {
   return *s;
 }
 
+// Triangles F (#F x 3) whose normal at X points against the one at rest R
+// (#V x 3 each), those under a thousandth of the mean rest area left out:
+// counted here, apart from the builder's turned_faces.
+int turned_over(const Eigen::MatrixXd &R, const Eigen::MatrixXi &F, const Eigen::MatrixXd &X) {
+  auto normal = [&F](const Eigen::MatrixXd &V, Eigen::Index f) {
+    const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
+    return Eigen::Vector3d((b - a).cross(c - a));
+  };
+  double mean_area = 0;
+  for (Eigen::Index f = 0; f < F.rows(); ++f) mean_area += normal(R, f).norm() / static_cast<double>(F.rows());
+  int n = 0;
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    const Eigen::Vector3d n0 = normal(R, f);
+    if (n0.norm() > 1e-3 * mean_area && n0.dot(normal(X, f)) <= 0) ++n;
+  }
+  return n;
+}
+
 // FAP `fap`'s target on side `side`, or nullptr.
 const MorphTarget *target(int fap, int side) {
   for (const MorphTarget &t : synthesis().targets)
@@ -444,21 +462,12 @@ TEST(FapSynthesis, NoTargetFlipsASkinTriangleOrSinksIntoTheSkull) {
   std::vector<char> on_jaw(static_cast<size_t>(s.n), 0);
   for (int v : m.jaw.vertices) on_jaw[static_cast<size_t>(v)] = 1;
   const Eigen::MatrixXd R = s.X0.topRows(s.n);
-  auto normal = [&](const Eigen::MatrixXd &X, int f) {
-    const Eigen::Vector3d a = X.row(s.F(f, 0)), b = X.row(s.F(f, 1)), c = X.row(s.F(f, 2));
-    return Eigen::Vector3d((b - a).cross(c - a));
-  };
-  double mean_area = 0;
-  for (int f = 0; f < s.F.rows(); ++f) mean_area += normal(R, f).norm() / static_cast<double>(s.F.rows());
   ASSERT_FALSE(synthesis().targets.empty());
   for (const MorphTarget &t : synthesis().targets) {
     SCOPED_TRACE("target kind " + std::to_string(t.kind) + " number " + std::to_string(t.number));
     const Eigen::MatrixXd X = R + t.displacement[static_cast<size_t>(m.skin)];
-    int flipped = 0, sunk = 0;
-    for (int f = 0; f < s.F.rows(); ++f) {
-      const Eigen::Vector3d n0 = normal(R, f);
-      if (n0.norm() > 1e-3 * mean_area && n0.dot(normal(X, f)) <= 0) ++flipped;
-    }
+    const int flipped = turned_over(R, s.F, X);
+    int sunk = 0;
     for (int v = 0; v < s.n; ++v) {
       if (on_jaw[static_cast<size_t>(v)] || !s.in_mesh[static_cast<size_t>(v)] || !skull_rejects(s, v)) continue;
       const Eigen::Vector3d n = s.normal.row(v), skull = s.X0.row(s.node(kSkull, v));
@@ -1213,22 +1222,8 @@ TEST(FapSynthesis, ATargetMadeOnASimulationMeshDoesNotFoldTheLiftedSkin) {
   const SimFaceModel &sm = song.built;
   ASSERT_TRUE(sm.sim.decimated);
   const Part &part = song.face.scene.parts[static_cast<size_t>(sm.sim.skin)];
-  // Input skin triangles (of at least a thousandth of the mean area) that
-  // displacement D (#V x 3) turns against their rest normal.
-  auto normal = [&part](const Eigen::MatrixXd &X, Eigen::Index f) {
-    const Eigen::Vector3d a = X.row(part.F(f, 0)), b = X.row(part.F(f, 1)), c = X.row(part.F(f, 2));
-    return Eigen::Vector3d((b - a).cross(c - a));
-  };
-  double mean = 0;
-  for (Eigen::Index f = 0; f < part.F.rows(); ++f) mean += normal(part.V, f).norm() / static_cast<double>(part.F.rows());
-  auto turned = [&](const Eigen::MatrixXd &D) {
-    int n = 0;
-    for (Eigen::Index f = 0; f < part.F.rows(); ++f) {
-      const Eigen::Vector3d n0 = normal(part.V, f);
-      if (n0.norm() > 1e-3 * mean && n0.dot(normal(part.V + D, f)) <= 0) ++n;
-    }
-    return n;
-  };
+  // Input skin triangles that displacement D (#V x 3) turns over.
+  auto turned = [&part](const Eigen::MatrixXd &D) { return turned_over(part.V, part.F, part.V + D); };
   struct Made {
     FapOutcome outcome;
     MorphTarget target;
