@@ -53,11 +53,33 @@ Expected<Jaw> build_jaw(const SkinModel &skin, const FdpSet &fdps, const Fapu &f
   for (int v : jaw.ray_hits)
     if (!std::binary_search(upper.begin(), upper.end(), v)) set.push_back(v);
   jaw.removed = static_cast<int>(jaw.ray_hits.size() - set.size());
-  // The lower lip the rays miss; the window reaches below the chin, whose
-  // underside is not lip: nothing below the chin's lowest point (2.1).
-  std::vector<int> lip;
+  // The lower lip the rays miss, the chin and its underside. The window
+  // reaches below the chin, onto its underside and at times down the neck,
+  // which the jaw does not carry. So: the window's vertices at or above 2.1;
+  // below it, those joined to them through skin that faces forward more
+  // than down (the chin's front: files place 2.1, the chin's lowest point,
+  // higher, Song's 9 mm above where its chin turns under), then through
+  // skin that faces down (the underside, over the floor of the mouth, which
+  // the opening jaw draws down), not on to the neck. Cut at 2.1, the skin below stayed on the
+  // skull and Song's opening jaw pushed 2.1 down past it; cut at the chin's
+  // front, its edge turned sharp.
+  std::vector<char> in_window(static_cast<size_t>(skin.n), 0);
+  for (int v : lower) in_window[static_cast<size_t>(v)] = 1;
+  auto fronts = [&](int v) { return skin.normal(v, 2) > -skin.normal(v, 1); };
+  std::vector<int> lip, queue;
+  std::vector<char> taken(static_cast<size_t>(skin.n), 0);
   for (int v : lower)
-    if (skin.X0(v, 1) >= P("2.1").y()) lip.push_back(v);
+    if (skin.X0(v, 1) >= P("2.1").y()) taken[static_cast<size_t>(v)] = 1, queue.push_back(v);
+  // Within 30 degrees of straight down: an underside, not a throat that
+  // slopes down to the neck (the generated heads').
+  auto under = [&](int v) { return -skin.normal(v, 1) > std::cos(30.0 * 3.14159265358979323846 / 180.0); };
+  for (bool front : {true, false})
+    for (size_t k = 0; k < queue.size(); ++k)
+      for (int u : skin.neighbours[static_cast<size_t>(queue[k])])
+        if (in_window[static_cast<size_t>(u)] && !taken[static_cast<size_t>(u)] && (front ? fronts(u) : under(u)))
+          taken[static_cast<size_t>(u)] = 1, queue.push_back(u);
+  for (int v : lower)
+    if (taken[static_cast<size_t>(v)]) lip.push_back(v);
   std::vector<int> merged;
   std::set_union(set.begin(), set.end(), lip.begin(), lip.end(), std::back_inserter(merged));
   jaw.added = static_cast<int>(merged.size() - set.size());

@@ -13,8 +13,10 @@
 // inward along its normal, 2.5 tissue thicknesses long; the vertices whose
 // segment meets the jaw mesh are the jaw's. Then the breadth-first fix: the
 // mouth-window search from 2.2 removes upper-lip vertices, the one from 2.3
-// adds the lower lip and chin, down to the chin's lowest point 2.1 (the
-// window reaches below it, onto the chin's underside).
+// adds the lower lip, the chin and its underside: down to 2.1, below it the
+// chin's front (skin facing forward more than down: files place 2.1, the
+// chin's lowest point, higher), then the underside (facing within 30
+// degrees of straight down), not the neck.
 //
 // Motion: rotation about the condyles' axis, +x through the pivot
 //   pivot = (0, mean of 5.3.y and 5.4.y, mean of 2.13.z and 2.14.z),

@@ -17,6 +17,7 @@
 #include "core/part_kind.h"
 #include "fap/fap_mapping.h"
 #include "fap/fap_partition.h"
+#include "fap/untangle.h"
 
 namespace afmb {
 
@@ -796,12 +797,37 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
                      "'s too: each moves it by a share, measured together at the same value";
     }
   }
+  // The slivers a target turns over are untangled (untangle.h). A FAP's
+  // FDP keeps the motion it was measured by, and the skin the solver holds
+  // off an eyeball stays as solved: a patch of Song's closing upper lid,
+  // moved affinely, left a hole in it.
   const Eigen::MatrixXd rest = skin.X0.topRows(skin.n);
-  for (Result &r : results) {
+  std::vector<char> held(static_cast<size_t>(skin.n), 0);
+  for (int v = 0; v < skin.n; ++v) held[static_cast<size_t>(v)] = skin.eye_near[static_cast<size_t>(v)] >= 0;
+  for (size_t k = 0; k < results.size(); ++k) {
+    Result &r = results[k];
     if (r.target) {
-      const Eigen::MatrixXd &D = r.target->displacement[static_cast<size_t>(model.skin)];
+      MorphTarget &t = *r.target;
+      Eigen::MatrixXd &D = t.displacement[static_cast<size_t>(model.skin)];
+      std::vector<char> fixed = held;
+      if (const FapMapping *f = work[k].fap) {
+        const afm_fap_info *info = afm_fap(f->fap);
+        const FdpPoint *p = model.fdps.find(FdpId{info->fdp_group, info->fdp_index}, model.skin);
+        if (p && p->part == model.skin && p->vertex >= 0) fixed[static_cast<size_t>(p->vertex)] = 1;
+      }
+      const Untangled u = untangle(rest, skin.F, fixed, options.sim, D);
+      if (u.moved > 0) {
+        for (const SkinBinding &b : carried) t.displacement[static_cast<size_t>(b.part)] = Eigen::MatrixXd();
+        carry(D, t);
+        char what[160];
+        std::snprintf(what, sizeof what,
+                      "untangled %d of %d turned triangles: %d vertices move in patches, each affinely "
+                      "or as one piece, changed by %.2g at most",
+                      u.turned_before - u.turned_after, u.turned_before, u.moved, u.largest_change);
+        r.outcome.message += std::string(r.outcome.message.empty() ? "" : "; ") + what;
+      }
       r.outcome.turned = static_cast<int>(turned_faces(rest, skin.F, rest + D).size());
-      out.targets.push_back(std::move(*r.target));
+      out.targets.push_back(std::move(t));
     }
     if (r.control) out.jaw.controls.push_back(*r.control);
     if (r.glide) out.jaw.controls.push_back(*r.glide);

@@ -614,8 +614,8 @@ TEST(Physics, TheJawOpens) {
   EXPECT_TRUE(p->X.allFinite());
   EXPECT_EQ(penetrating_nodes(m.tissue, p->X, 1e-9), 0);
   // The jaw holds the lower lip (the mouth-window search adds what the rays
-  // miss), not the upper lip (it removes what they hit) nor the chin's
-  // underside.
+  // miss), not the upper lip (it removes what they hit); below the chin
+  // only its front and underside, not the neck (jaw.h).
   EXPECT_GT(m.jaw.added, 0);
   Expected<MouthLips> lips = mouth_lips(m.tissue, m.fdps);
   ASSERT_TRUE(lips.is_ok()) << lips.status().message();
@@ -630,11 +630,19 @@ TEST(Physics, TheJawOpens) {
   for (int v : lips->upper) EXPECT_FALSE(on_jaw(v)) << "upper-lip vertex " << v;
   std::printf("jaw: %zu vertices, %zu ray hits, %d removed, %d added\n", m.jaw.vertices.size(), m.jaw.ray_hits.size(),
               m.jaw.removed, m.jaw.added);
+  int below = 0;
   for (int v : m.jaw.vertices) {
-    if (!std::binary_search(m.jaw.ray_hits.begin(), m.jaw.ray_hits.end(), v)) {
-      EXPECT_GE(m.tissue.X0(v, 1), chin_bottom) << "vertex " << v << " added below the chin";
-    }
+    if (std::binary_search(m.jaw.ray_hits.begin(), m.jaw.ray_hits.end(), v) || m.tissue.X0(v, 1) >= chin_bottom)
+      continue;
+    ++below;
+    const Eigen::Vector3d n = m.tissue.normal.row(v);
+    EXPECT_TRUE(n.z() > -n.y() || -n.y() > std::sqrt(3.0) / 2)
+        << "vertex " << v << " added below the chin faces neither forward nor down: " << n.transpose();
   }
+  // Not the neck: nothing added below the chin lies a chin's height under it.
+  const double chin_height = m.fdps.find(*FdpId::parse("2.3"))->pos.y() - chin_bottom;
+  for (int v : m.jaw.vertices) EXPECT_GT(m.tissue.X0(v, 1), chin_bottom - chin_height) << "vertex " << v;
+  std::printf("jaw: %d vertices added below the chin\n", below);
 }
 
 TEST(Physics, APoseStartedFromANearbyOneIsTheSameEquilibrium) {

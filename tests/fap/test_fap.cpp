@@ -27,6 +27,7 @@
 #include "fap/fap_mapping.h"
 #include "fap/fap_partition.h"
 #include "fap/fap_synthesis.h"
+#include "fap/untangle.h"
 #include "io/load_face.h"
 #include "refhead/refhead.h"
 #include "../common/reference_model.h"
@@ -504,6 +505,66 @@ TEST(FapSynthesis, SkinFaultsSeeAFoldAndASunkVertex) {
   const Eigen::Vector3d a = R.row(s.F(0, 0)), b = R.row(s.F(0, 1)), c = R.row(s.F(0, 2));
   E.row(s.F(0, 0)) = (b + c - a).transpose();
   EXPECT_GE(skin_faults(m, E).turned_faces.size(), 1u);
+}
+
+// untangle() (untangle.h) on a flat 6 x 6 grid whose middle vertex is
+// carried across its neighbours: the turned triangles and the vertices
+// around them move as a patch, nothing turns after, and the rest of the
+// field is kept. A patch holding a fixed vertex stays as solved. A field
+// that turns nothing is left alone.
+TEST(Untangle, APatchTurnsNoTriangleAndOneHoldingAFixedVertexStaysAsSolved) {
+  const int k = 6;
+  Eigen::MatrixXd V(k * k, 3);
+  for (int i = 0; i < k; ++i)
+    for (int j = 0; j < k; ++j) V.row(i * k + j) << j, i, 0;
+  Eigen::MatrixXi F(2 * (k - 1) * (k - 1), 3);
+  int f = 0;
+  for (int i = 0; i + 1 < k; ++i)
+    for (int j = 0; j + 1 < k; ++j) {
+      const int a = i * k + j;
+      F.row(f++) << a, a + 1, a + k + 1;
+      F.row(f++) << a, a + k + 1, a + k;
+    }
+  const int mid = 2 * k + 2;
+  Eigen::MatrixXd D = Eigen::MatrixXd::Constant(k * k, 3, 0.0);
+  D.col(2).setConstant(0.5);  // all of it lifts
+  D(mid, 0) = 1.6;            // and the middle passes its right neighbour
+  ASSERT_GT(turned_faces(V, F, V + D).size(), 0u);
+  const std::vector<char> none;
+  Eigen::MatrixXd E = D;
+  const Untangled u = untangle(V, F, none, nullptr, E);
+  EXPECT_EQ(u.turned_before, static_cast<int>(turned_faces(V, F, V + D).size()));
+  EXPECT_EQ(u.turned_after, 0);
+  EXPECT_TRUE(turned_faces(V, F, V + E).empty());
+  EXPECT_GT(u.moved, 1);
+  EXPECT_LT(u.moved, k * k / 2) << "the patch stays local";
+  EXPECT_NEAR(u.largest_change, (E - D).rowwise().norm().maxCoeff(), 1e-15);
+  int kept = 0;
+  for (int v = 0; v < k * k; ++v) kept += E.row(v) == D.row(v);
+  EXPECT_EQ(kept, k * k - u.moved);
+  // The middle fixed: its patch stays as solved, and says what still turns.
+  std::vector<char> fixed(static_cast<size_t>(k * k), 0);
+  fixed[static_cast<size_t>(mid)] = 1;
+  E = D;
+  const Untangled y = untangle(V, F, fixed, nullptr, E);
+  EXPECT_EQ(E, D);
+  EXPECT_EQ(y.moved, 0);
+  EXPECT_EQ(y.turned_after, y.turned_before);
+  // A fixed vertex away from the fold does not hold it.
+  std::fill(fixed.begin(), fixed.end(), 0);
+  fixed[0] = 1;
+  E = D;
+  EXPECT_EQ(untangle(V, F, fixed, nullptr, E).turned_after, 0);
+  EXPECT_EQ(E.row(0), D.row(0));
+  std::printf("the middle carried 1.6 across: %d turned; untangled: %d vertices changed by %.2f at most\n",
+              u.turned_before, u.moved, u.largest_change);
+  // Nothing turns: nothing changes.
+  Eigen::MatrixXd G = Eigen::MatrixXd::Constant(k * k, 3, 0.25);
+  const Eigen::MatrixXd G0 = G;
+  const Untangled x = untangle(V, F, none, nullptr, G);
+  EXPECT_EQ(x.turned_before, 0);
+  EXPECT_EQ(x.moved, 0);
+  EXPECT_EQ(G, G0);
 }
 
 // Groups too weak within their calibrated range pass it (their tensions
@@ -1084,12 +1145,13 @@ TEST(FapSynthesis, TargetsMadeOnACoarserSimulationMeshMatchTheSkins) {
 }
 
 // Song as afm-build models it, on its default simulation mesh, with only
-// `muscles` calibrated and no jaw; the loaded face (its whole skin) beside it.
+// `muscles` calibrated (none when empty) and the jaw when `jaw`; the loaded
+// face (its whole skin) beside it.
 struct SongOnSimMesh {
   LoadedFace face;
   SimFaceModel built;
 };
-SongOnSimMesh song_on_sim_mesh(const std::vector<std::string> &muscles) {
+SongOnSimMesh song_on_sim_mesh(const std::vector<std::string> &muscles, bool jaw = false) {
   SongOnSimMesh out;
   Expected<LoadedFace> f = load_face(afmtest::shared_data("faces/song/song.WRL"),
                                      afmtest::shared_data("faces/song/song.fdp"), LoadOptions{}, nullptr);
@@ -1098,7 +1160,8 @@ SongOnSimMesh song_on_sim_mesh(const std::vector<std::string> &muscles) {
   out.face = std::move(*f);
   FaceModelOptions fo;
   fo.calibrate_only = muscles;
-  fo.calibrate_jaw = false;
+  fo.calibrate_muscles = !muscles.empty();
+  fo.calibrate_jaw = jaw;
   Expected<SimFaceModel> m =
       build_sim_face_model(out.face.scene, out.face.fdps, SimMeshOptions{kDefaultSimVertices}, fo);
   EXPECT_TRUE(m.is_ok()) << m.status().message();
@@ -1265,6 +1328,59 @@ TEST(FapSynthesis, ATargetMadeOnASimulationMeshDoesNotFoldTheLiftedSkin) {
   std::printf("FAP 16 (negative): blind to the lifted skin %.0f %% reached, %d triangles turned; seeing it %.0f %% "
               "at %.2f times the table's contractions\n",
               100 * blind.outcome.reached, blind_turned, 100 * seeing.outcome.reached, seeing.outcome.scale);
+}
+
+// Song's jaw, opened as FAP 3 says, on afm-build's simulation mesh: the
+// skin it stores turns no triangle, and the chin below 2.1 goes down with
+// it. Before, the jaw carried the skin down to 2.1 only, which Song's file
+// places 9 mm above where its chin turns under: the skin 2.4 mm under 2.1
+// moved a tenth as far, 2.1 passed it, and 15 triangles turned (the
+// mouth corners' slivers among them; untangle.h).
+TEST(FapSynthesis, SongsOpeningJawTakesItsChinAlongAndTurnsNoTriangle) {
+  AFM_REQUIRE_SHARED_DATA();
+  SongOnSimMesh song = song_on_sim_mesh({}, /*jaw=*/true);
+  ASSERT_FALSE(HasFailure());
+  const SimFaceModel &sm = song.built;
+  ASSERT_TRUE(sm.sim.decimated);
+  const Part &part = song.face.scene.parts[static_cast<size_t>(sm.sim.skin)];
+  FapSynthesisOptions o;
+  o.only = {3};
+  o.sim = &sm.sim;
+  Expected<FapSynthesis> syn = synthesize_faps(sm.scene, sm.model, o);
+  ASSERT_TRUE(syn.is_ok()) << syn.status().message();
+  lift_synthesis(*syn, sm.sim);
+  ASSERT_EQ(syn->targets.size(), 1u);
+  ASSERT_TRUE(syn->outcomes[0].made) << syn->outcomes[0].message;
+  const Eigen::MatrixXd &D = syn->targets[0].displacement[static_cast<size_t>(sm.sim.skin)];
+  ASSERT_EQ(D.rows(), part.V.rows());
+  EXPECT_EQ(turned_over(part.V, part.F, part.V + D), 0);
+  EXPECT_EQ(syn->outcomes[0].turned, 0);
+  // The jaw's own pose at that opening, before any untangling: 2.1 and the
+  // nearest simulation vertex under it on the midline, 1 to 10 mm lower.
+  const FaceModel &m = sm.model;
+  Activation a;
+  a.jaw_open = 100 * syn->outcomes[0].scale;
+  FactorCache cache;
+  Expected<Pose> pose = solve_pose(m, a, &cache);
+  ASSERT_TRUE(pose.is_ok()) << pose.status().message();
+  const Eigen::MatrixXd E = pose_epidermis(m, *pose);
+  const FdpPoint *chin = m.fdps.find(FdpId{2, 1}, m.skin);
+  ASSERT_TRUE(chin && chin->vertex >= 0);
+  const Eigen::MatrixXd X0 = m.tissue.X0.topRows(m.tissue.n);
+  const Eigen::Vector3d c = X0.row(chin->vertex);
+  int under = -1;
+  for (int v = 0; v < m.tissue.n; ++v) {
+    const double drop = c.y() - X0(v, 1);
+    if (std::abs(X0(v, 0) - c.x()) < 0.5 && drop > 1 && drop < 10 && (under < 0 || drop < c.y() - X0(under, 1)))
+      under = v;
+  }
+  ASSERT_GE(under, 0);
+  const double chin_drop = X0(chin->vertex, 1) - E(chin->vertex, 1), under_drop = X0(under, 1) - E(under, 1);
+  EXPECT_GT(chin_drop, 1.0);
+  EXPECT_GT(under_drop, 0.5 * chin_drop) << "the skin under 2.1 stays behind";
+  std::printf("FAP 3 (%.0f %% open): 2.1 goes down %.2f, the skin %.1f under it %.2f; the target turns %d "
+              "triangles\n",
+              a.jaw_open, chin_drop, c.y() - X0(under, 1), under_drop, turned_over(part.V, part.F, part.V + D));
 }
 
 // Joy on the generated 3k head, simulated on 1,500 vertices, folds the

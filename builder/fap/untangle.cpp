@@ -1,0 +1,115 @@
+#include "fap/untangle.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <numeric>
+
+#include "anatomy/face_model.h"
+
+namespace afmb {
+
+Untangled untangle(const Eigen::MatrixXd &V0, const Eigen::MatrixXi &F, const std::vector<char> &fixed,
+                   const SimMesh *sim, Eigen::MatrixXd &D) {
+  const bool lifted = sim && sim->decimated;
+  std::vector<int> coarse, fine;  // the turned triangles of the last count
+  auto count = [&](const Eigen::MatrixXd &E) {
+    coarse = turned_faces(V0, F, V0 + E);
+    fine = lifted ? lifted_turned_faces(*sim, E) : std::vector<int>();
+    return static_cast<int>(coarse.size() + fine.size());
+  };
+  Untangled out;
+  out.turned_before = out.turned_after = count(D);
+  if (out.turned_before == 0) return out;
+
+  // Patches: a union-find over the vertices; `rigid` and `pinned` per root.
+  const size_t n = static_cast<size_t>(V0.rows());
+  std::vector<int> root(n);
+  std::iota(root.begin(), root.end(), 0);
+  std::vector<char> member(n, 0), rigid(n, 0), pinned(n, 0);
+  auto find = [&root](int v) {
+    while (root[static_cast<size_t>(v)] != v)
+      v = root[static_cast<size_t>(v)] = root[static_cast<size_t>(root[static_cast<size_t>(v)])];
+    return v;
+  };
+  auto join = [&](int a, int b) {
+    a = find(a), b = find(b);
+    if (a == b) return;
+    const size_t r = static_cast<size_t>(std::min(a, b)), o = static_cast<size_t>(std::max(a, b));
+    root[o] = static_cast<int>(r);
+    rigid[r] = rigid[r] || rigid[o];
+    pinned[r] = pinned[r] || pinned[o];
+  };
+  // The coarse vertices a turned triangle stands for: its corners, or for a
+  // lifted one the coarse vertices its corners are bound to.
+  auto corners_of = [&](bool is_fine, int f, std::vector<int> &c) {
+    c.clear();
+    if (!is_fine) {
+      for (int k = 0; k < 3; ++k) c.push_back(F(f, k));
+      return;
+    }
+    for (int k = 0; k < 3; ++k) {
+      const int v = sim->skin_F(f, k);
+      for (int j = 0; j < 3; ++j)
+        if (sim->binding.weight(v, j) > 0) c.push_back(sim->binding.corner(v, j));
+    }
+  };
+
+  const Eigen::MatrixXd original = D;
+  Eigen::MatrixXd best = D;
+  std::vector<int> c;
+  for (int round = 0; round < kUntangleMaxRounds && out.turned_after > 0; ++round) {
+    // A triangle that turns inside a patch (all it stands for in one) makes
+    // that patch move as one piece; then every turned triangle joins one.
+    for (bool is_fine : {false, true})
+      for (int f : is_fine ? fine : coarse) {
+        corners_of(is_fine, f, c);
+        bool inside = true;
+        for (int v : c) inside = inside && member[static_cast<size_t>(v)] && find(v) == find(c[0]);
+        if (inside) rigid[static_cast<size_t>(find(c[0]))] = 1;
+      }
+    for (bool is_fine : {false, true})
+      for (int f : is_fine ? fine : coarse) {
+        corners_of(is_fine, f, c);
+        for (int v : c) {
+          member[static_cast<size_t>(v)] = 1;
+          if (!fixed.empty() && fixed[static_cast<size_t>(v)]) pinned[static_cast<size_t>(find(v))] = 1;
+          join(c[0], v);
+        }
+      }
+    std::vector<std::vector<int>> patches(n);
+    for (size_t v = 0; v < n; ++v)
+      if (member[v]) patches[static_cast<size_t>(find(static_cast<int>(v)))].push_back(static_cast<int>(v));
+    D = original;
+    for (size_t r = 0; r < n; ++r) {
+      const std::vector<int> &p = patches[r];
+      if (p.empty() || pinned[r]) continue;  // a patch holding a fixed vertex stays as solved
+      // The affine motion nearest the solved one (least squares, the
+      // minimum-norm one where the patch is flat), or one translation, the
+      // mean, for a patch that turned inside.
+      const Eigen::Index m = static_cast<Eigen::Index>(p.size());
+      Eigen::MatrixXd X(m, 4), Y(m, 3);
+      Eigen::RowVector3d centre = Eigen::RowVector3d::Zero();
+      for (int v : p) centre += V0.row(v);
+      centre /= static_cast<double>(m);
+      for (Eigen::Index i = 0; i < m; ++i) {
+        X.row(i) << V0.row(p[static_cast<size_t>(i)]) - centre, 1.0;
+        Y.row(i) = original.row(p[static_cast<size_t>(i)]);
+      }
+      Eigen::MatrixXd W = Eigen::MatrixXd::Zero(4, 3);
+      if (rigid[r] || m < 4) W.row(3) = Y.colwise().mean();
+      else W = X.completeOrthogonalDecomposition().solve(Y);
+      const Eigen::MatrixXd fit = X * W;
+      for (Eigen::Index i = 0; i < m; ++i) D.row(p[static_cast<size_t>(i)]) = fit.row(i);
+    }
+    const int now = count(D);
+    if (now < out.turned_after) out.turned_after = now, best = D;
+  }
+  D = std::move(best);
+  for (Eigen::Index v = 0; v < D.rows(); ++v) {
+    out.moved += D.row(v) != original.row(v);
+    out.largest_change = std::max(out.largest_change, (D.row(v) - original.row(v)).norm());
+  }
+  return out;
+}
+
+}  // namespace afmb

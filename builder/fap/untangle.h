@@ -1,0 +1,58 @@
+// Untangling the slivers a target turns over.
+//
+// Why: a solved pose can turn a few skin triangles over where the mesh is
+// much finer than the motion. The springs keep lengths, not a sliver's
+// facing. Song's mouth corners hold a fan of slivers a tenth of a
+// millimetre wide between the lower lip, which the jaw carries, and the
+// upper lip, which stays; opening the jaw turned 11 of them. The skin
+// solved on all of Song's vertices turned the same ones, so a finer
+// simulation does not help.
+//
+// The rule: the corners of each turned triangle join one patch, and each
+// patch takes the affine motion nearest the solved one (least squares over
+// its members). An affine motion stretches and shears the patch evenly: a
+// sliver inside turns only if the whole patch does. A patch inside which a
+// triangle still turns moves as one piece instead (the mean of its
+// members' motion), which turns nothing inside. Triangles that turn then,
+// at a patch's edge, join it in the next round, until nothing turns or
+// kUntangleMaxRounds. A patch holding a vertex marked `fixed` (a FAP's own
+// FDP, which keeps the motion it was measured by) stays as solved, and what
+// turns in it stays turned, for the caller to report: the folds at the
+// lower lip's FDPs that the split of shared skin makes (fap_partition.h)
+// are such. Moved with the FDP, as one piece or as a harmonic blend, the
+// skin around the 10k head's lower lip FDP went 7 mm. The rest shape is
+// kept; only the motion within the patches changes. Where the solve tears
+// a corner apart (Song's mouth corner: the lower lip, carried by the jaw,
+// moves 1.6 mm from the upper one, which stays, within a millimetre) the
+// change is about half of that jump.
+//
+// On a simulation mesh (`sim` decimated), what is stored is the lifted
+// skin (sim_mesh.h), so its turned triangles count too: each stands for
+// the coarse vertices its corners are bound to.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "anatomy/sim_mesh.h"
+
+namespace afmb {
+
+constexpr int kUntangleMaxRounds = 32;  // then it gives up, keeping the best round
+
+struct Untangled {
+  int turned_before = 0;  // turned triangles before (coarse plus lifted)
+  int turned_after = 0;   // after: 0 unless it gave up
+  int moved = 0;          // vertices whose displacement changed (in the patches)
+  double largest_change = 0;  // the largest change of a vertex's displacement, model units
+};
+
+// Untangles D (#V x 3, model units: the displacement of the mesh V0 #V x 3,
+// F #F x 3) in place. `fixed`: #V flags, or empty. `sim`: the simulation
+// mesh whose coarse skin V0 is, or null. D is left as it was when nothing
+// turns; when not everything untangles, D is the round with the fewest
+// turned triangles.
+Untangled untangle(const Eigen::MatrixXd &V0, const Eigen::MatrixXi &F, const std::vector<char> &fixed,
+                   const SimMesh *sim, Eigen::MatrixXd &D);
+
+}  // namespace afmb
