@@ -60,9 +60,9 @@ Expected<Jaw> build_jaw(const SkinModel &skin, const FdpSet &fdps, const Fapu &f
   // than down (the chin's front: files place 2.1, the chin's lowest point,
   // higher, Song's 9 mm above where its chin turns under), then through
   // skin that faces down (the underside, over the floor of the mouth, which
-  // the opening jaw draws down), not on to the neck. Cut at 2.1, the skin below stayed on the
-  // skull and Song's opening jaw pushed 2.1 down past it; cut at the chin's
-  // front, its edge turned sharp.
+  // the opening jaw draws down), not on to the neck. Cut at 2.1, the skin
+  // below stayed on the skull and Song's opening jaw pushed 2.1 down past
+  // it; cut at the chin's front, its edge turned sharp.
   std::vector<char> in_window(static_cast<size_t>(skin.n), 0);
   for (int v : lower) in_window[static_cast<size_t>(v)] = 1;
   auto fronts = [&](int v) { return skin.normal(v, 2) > -skin.normal(v, 1); };

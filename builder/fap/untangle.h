@@ -4,8 +4,8 @@
 // much finer than the motion. The springs keep lengths, not a sliver's
 // facing. Song's mouth corners hold a fan of slivers a tenth of a
 // millimetre wide between the lower lip, which the jaw carries, and the
-// upper lip, which stays; opening the jaw turned 11 of them. The skin
-// solved on all of Song's vertices turned the same ones, so a finer
+// upper lip, which stays; opening the jaw turned a dozen of them, and as
+// many when the skin was solved on all of Song's vertices: a finer
 // simulation does not help.
 //
 // The rule: the corners of each turned triangle join one patch, and each
@@ -16,7 +16,8 @@
 // members' motion), which turns nothing inside. Triangles that turn then,
 // at a patch's edge, join it in the next round, until nothing turns or
 // kUntangleMaxRounds. A patch holding a vertex marked `fixed` (a FAP's own
-// FDP, which keeps the motion it was measured by) stays as solved, and what
+// FDP, which keeps the motion it was measured by; the synthesis marks the
+// skin held off an eyeball too) stays as solved, and what
 // turns in it stays turned, for the caller to report: the folds at the
 // lower lip's FDPs that the split of shared skin makes (fap_partition.h)
 // are such. Moved with the FDP, as one piece or as a harmonic blend, the
@@ -42,7 +43,7 @@ constexpr int kUntangleMaxRounds = 32;  // then it gives up, keeping the best ro
 
 struct Untangled {
   int turned_before = 0;  // turned triangles before (coarse plus lifted)
-  int turned_after = 0;   // after: 0 unless it gave up
+  int turned_after = 0;   // after: 0 unless it gave up or a fixed vertex holds a fold
   int moved = 0;          // vertices whose displacement changed (in the patches)
   double largest_change = 0;  // the largest change of a vertex's displacement, model units
 };
