@@ -121,7 +121,6 @@ Input build(const std::string &name, const Scene &scene, const FdpSet &fdps, int
   so.progress = [](int d, int n, const std::string &w) { progress("targets", d, n, w); };
   Expected<FapSynthesis> syn = synthesize_faps(model->scene, model->model, so);
   if (!syn) die(name + ": " + syn.status().message());
-  lift_synthesis(*syn, model->sim);
   AfmContent content = fap_afm_content(scene, fdps, model->model, std::move(*syn));
   Expected<std::vector<uint8_t>> raw = encode_afm(content, AFM_PROFILE_RAW);
   if (!raw) die(name + ": " + raw.status().message());

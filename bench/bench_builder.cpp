@@ -76,7 +76,6 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
     if (s) so.sim = &s->sim;
     Expected<FapSynthesis> st = s ? synthesize_faps(s->scene, s->model, so) : Expected<FapSynthesis>(s.status());
     if (st) {
-      lift_synthesis(*st, s->sim);
       size_t under = 0;
       for (const FapOutcome &o : st->outcomes) under += o.made && o.reached < 1;
       Expected<std::vector<uint8_t>> bytes =

@@ -834,11 +834,12 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     out.outcomes.push_back(std::move(r.outcome));
   }
   if (out.jaw.controls.empty()) out.jaw.parts.clear();
+  if (options.sim) lift_synthesis(out, *options.sim);
   return out;
 }
 
 void lift_synthesis(FapSynthesis &synthesis, const SimMesh &sim) {
-  if (!sim.decimated) return;
+  if (!sim.decimated || synthesis.lift.control_count > 0) return;
   const size_t skin = static_cast<size_t>(sim.skin);
   synthesis.lift.control_count = static_cast<int>(sim.V.rows());
   synthesis.lift.parts = {sim.binding};

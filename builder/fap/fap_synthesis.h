@@ -125,8 +125,9 @@ struct FapSynthesisOptions {
   int threads = 0;
   // The simulation mesh the model was built on (sim_mesh.h), when it is
   // decimated: the skin the targets are lifted to may not fold either
-  // (SkinFaults::lifted_turned_faces). Not owned; null: the model's skin is
-  // the input's.
+  // (SkinFaults::lifted_turned_faces), and the synthesis is lifted to it
+  // (lift_synthesis) before it is returned. Not owned; null: the model's
+  // skin is the input's.
   const SimMesh *sim = nullptr;
   // Called after each target: done of total, and which (from the workers,
   // one call at a time).
@@ -167,12 +168,15 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
                                        const FapSynthesisOptions &options = {});
 
 // Carries a synthesis made on a simulation mesh (sim_mesh.h: the model built
-// on sim_scene) to the skin: every target's skin displacement becomes #V x 3
+// on sim_scene) to the skin. synthesize_faps does it when given the mesh
+// (FapSynthesisOptions::sim), and only then is the lifted skin checked for
+// folds: called on a synthesis made without it, the lift is blind to them.
+// What it does: every target's skin displacement becomes #V x 3
 // over the skin's own vertices, and the `largest` of each viseme and
 // expression is measured there. The simulation mesh's displacement becomes
 // the target's `controls`, and `lift` binds the skin and the carried parts
 // to them (formats/afm.md, LIFT). Nothing changes when the simulation mesh
-// is the skin.
+// is the skin, or on a synthesis already lifted.
 void lift_synthesis(FapSynthesis &synthesis, const SimMesh &sim);
 
 // The AFM's content: the scene, its input FDPs (bound to `scene`; not the

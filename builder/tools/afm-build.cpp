@@ -408,7 +408,6 @@ int main(int argc, char **argv) {
     so.sim = sim;
     Expected<FapSynthesis> syn = synthesize_faps(scene, *model, so);
     if (!syn) return fail(syn.status());
-    lift_synthesis(*syn, *sim);
     std::printf("%s", fidelity_table(*syn).c_str());
     if (!report_dir.empty()) {
       FidelityReportOptions ro;
