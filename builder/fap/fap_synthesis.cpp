@@ -182,6 +182,12 @@ void keep_lid_half(const FaceModel &model, int fap, int lid, Eigen::MatrixXd &D)
 
 // The errors of achieved FDP motion against o.prescribed, along the FAP's
 // direction `dir` and off it.
+// The skin vertex of FAP `info`'s FDP, or -1 when the FDP is not on the skin.
+int fdp_vertex(const FaceModel &model, const afm_fap_info *info) {
+  const FdpPoint *p = model.fdps.find(FdpId{info->fdp_group, info->fdp_index}, model.skin);
+  return p && p->part == model.skin && p->vertex >= 0 ? p->vertex : -1;
+}
+
 void measure(FapOutcome &o, const Eigen::Vector3d &achieved, const Eigen::Vector3d &dir) {
   o.achieved = achieved;
   const double len = o.prescribed.norm();
@@ -704,12 +710,12 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     const FapMapping *f = work[k].fap;
     if (!f || f->driver != FapDriver::Muscles) continue;
     const afm_fap_info *info = afm_fap(f->fap);
-    const FdpPoint *p = model.fdps.find(FdpId{info->fdp_group, info->fdp_index}, model.skin);
-    if (!p || p->part != model.skin || p->vertex < 0) continue;  // not made: no copy
+    const int fdp = fdp_vertex(model, info);
+    if (fdp < 0) continue;  // not made: no copy
     std::vector<std::pair<std::string, double>> group;
     for (const FapContraction &c : fap_group(model, *f, work[k].side)) group.push_back({c.muscle, c.percent});
     const Eigen::Vector3d along = work[k].side * fap_direction(info);
-    keys[k] = SolveKey{group, p->vertex, along.x(), along.y(), along.z(),
+    keys[k] = SolveKey{group, fdp, along.x(), along.y(), along.z(),
                        work[k].reference * fapu_distance(model.fapu, info->unit), f->lid};
   }
   std::vector<size_t> same_as(work.size());
@@ -751,10 +757,10 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       // reference: it takes no share apart from the FAP's.
       if (!f || f->driver != FapDriver::Muscles || f->lid || work[k].in_between || !results[k].target) continue;
       const afm_fap_info *info = afm_fap(f->fap);
-      const FdpPoint *p = model.fdps.find(FdpId{info->fdp_group, info->fdp_index}, model.skin);
-      if (!p || p->part != model.skin || p->vertex < 0) continue;
+      const int fdp = fdp_vertex(model, info);
+      if (fdp < 0) continue;
       sharing[k].fap = f->fap;
-      sharing[k].vertex = p->vertex;
+      sharing[k].vertex = fdp;
       for (const FapContraction &c : fap_group(model, *f, work[k].side))
         sharing[k].muscles.push_back({c.muscle, c.percent > 0 ? +1 : -1});
       sharing[k].direction = fap_direction(info);
@@ -810,11 +816,8 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       MorphTarget &t = *r.target;
       Eigen::MatrixXd &D = t.displacement[static_cast<size_t>(model.skin)];
       std::vector<char> fixed = held;
-      if (const FapMapping *f = work[k].fap) {
-        const afm_fap_info *info = afm_fap(f->fap);
-        const FdpPoint *p = model.fdps.find(FdpId{info->fdp_group, info->fdp_index}, model.skin);
-        if (p && p->part == model.skin && p->vertex >= 0) fixed[static_cast<size_t>(p->vertex)] = 1;
-      }
+      if (const FapMapping *f = work[k].fap)
+        if (const int fdp = fdp_vertex(model, afm_fap(f->fap)); fdp >= 0) fixed[static_cast<size_t>(fdp)] = 1;
       const Untangled u = untangle(rest, skin.F, fixed, options.sim, D);
       if (u.moved > 0) {
         for (const SkinBinding &b : carried) t.displacement[static_cast<size_t>(b.part)] = Eigen::MatrixXd();
