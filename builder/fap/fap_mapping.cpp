@@ -109,6 +109,36 @@ std::vector<FapMapping> make_table() {
   for (int f = 65; f <= 68; ++f)
     add(f, D::None, 0, {}, {}, "human ears do not move: the auricular muscles are vestigial");
   std::sort(t.begin(), t.end(), [](const FapMapping &a, const FapMapping &b) { return a.fap < b.fap; });
+  // Helpers (fap_mapping.h): the muscles beside the group's that move its
+  // FDP, each FAP's own side's. Left out: the lids (they follow the
+  // eyeball, and so does their off-axis motion), pushing the lips and the
+  // chin (nothing behind the lips to push against), bending the nose.
+  auto help = [&t](int fap, std::vector<std::string> names) {
+    t[static_cast<size_t>(fap - 3)].helpers = std::move(names);
+  };
+  for (int o : {0, 47}) {
+    help(4 + o, {"orbicularis_oris"});
+    help(5 + o, {"orbicularis_oris", "depressor_anguli_left", "depressor_anguli_right"});
+    for (const char *s : {"left", "right"}) {
+      const std::string side = s;
+      const int k = side == "left" ? 0 : 1;
+      help(6 + k + o, {"zygomaticus_major_" + side, "depressor_anguli_" + side});
+      help(8 + k + o, {"zygomaticus_minor_" + side, "orbicularis_oris"});
+      help(10 + k + o, {"depressor_anguli_" + side, "orbicularis_oris"});
+      help(12 + k + o, {"zygomaticus_minor_" + side, "upper_lip_" + side, "risorius_" + side, "orbicularis_oris"});
+    }
+  }
+  for (const char *s : {"left", "right"}) {
+    const std::string side = s;
+    const int k = side == "left" ? 0 : 1;
+    help(31 + k, {"corrugator_" + side, "frontalis_major_" + side});
+    help(33 + k, {"frontalis_inner_" + side, "frontalis_outer_" + side, "corrugator_" + side});
+    help(35 + k, {"frontalis_major_" + side, "corrugator_" + side});
+    help(37 + k, {"frontalis_inner_" + side});
+    help(41 + k, {"orbicularis_oculi_" + side, "risorius_" + side, "upper_lip_" + side});
+    help(61 + k, {"upper_lip_" + side, "zygomaticus_minor_" + side});
+  }
+  help(63, {"upper_lip_left", "upper_lip_right"});
   return t;
 }
 
@@ -230,6 +260,7 @@ std::string fap_mapping_text() {
     for (int r : m.farther) out += "," + std::to_string(r);
     if (!m.positive.empty()) out += "  + " + group(m.positive);
     if (!m.negative.empty()) out += "  - " + group(m.negative);
+    for (size_t k = 0; k < m.helpers.size(); ++k) out += (k ? ", " : "  helpers ") + m.helpers[k];
     if (m.note && *m.note) out += std::string("  (") + m.note + ")";
     out += "\n";
   }

@@ -60,6 +60,12 @@ struct FapMapping {
   // reference takes the lid along the chord, into the eyeball. Each is made
   // only where the group reaches it in full; the report lists the others.
   std::vector<int> farther;
+  // Helpers: muscles around the FDP that may join the group, at most
+  // kHelperBound of their range either way, to steer the FDP's motion back
+  // onto the FAP's direction where the group's own pose drifts off it (the
+  // synthesis, fap_synthesis.h, chooses how much). The group's own muscles
+  // never help their own side. Empty: the group acts alone.
+  std::vector<std::string> helpers;
 };
 
 // Every FAP 3..68 once, in number order.

@@ -17,6 +17,7 @@
 #include "core/part_kind.h"
 #include "fap/fap_mapping.h"
 #include "fap/fap_partition.h"
+#include "fap/steer.h"
 #include "fap/untangle.h"
 
 namespace afmb {
@@ -225,6 +226,8 @@ CalibrationNeeds calibration_needs(const FapSynthesisOptions &options) {
     need.jaw |= m.driver == FapDriver::JawOpen || m.driver == FapDriver::JawThrust || m.driver == FapDriver::JawShift;
     if (m.driver != FapDriver::Muscles) continue;
     for (const auto *g : {&m.positive, &m.negative, &m.fallback_positive, &m.fallback_negative}) add(*g);
+    for (const std::string &h : m.helpers)
+      if (std::find(need.muscles.begin(), need.muscles.end(), h) == need.muscles.end()) need.muscles.push_back(h);
   }
   for (const HighLevelMapping &h : high_level_mappings()) {
     if (!listed(h.expression ? options.only_expressions : options.only_visemes, h.number)) continue;
@@ -622,6 +625,12 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
             scale = s2, capped = capped2, cap = kMaxFapScale;
           }
         }
+        // Where the group's pose drifts off the FAP's direction, helpers
+        // steer the FDP back (steer.h). Not on a fallback group.
+        std::string steered;
+        if (pz && !fallback && !map->helpers.empty() && options.steer)
+          steered = steer_group(model, map->helpers, pattern, fdp->vertex, side * dir, action, value, cap, &cache,
+                                face_faults, *pz, scale, capped);
         if (pz && !capped) {
           pose = std::move(*pz);
           o.scale = scale;
@@ -674,6 +683,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
             }
           }
         }
+        if (ok && !steered.empty()) o.message += (o.message.empty() ? "" : "; ") + steered;
       }
     }
     if (ok && o.in_between && o.reached < 1) {
@@ -714,6 +724,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     if (fdp < 0) continue;  // not made: no copy
     std::vector<std::pair<std::string, double>> group;
     for (const FapContraction &c : fap_group(model, *f, work[k].side)) group.push_back({c.muscle, c.percent});
+    for (const std::string &h : f->helpers) group.push_back({"helper " + h, 0});
     const Eigen::Vector3d along = work[k].side * fap_direction(info);
     keys[k] = SolveKey{group, fdp, along.x(), along.y(), along.z(),
                        work[k].reference * fapu_distance(model.fapu, info->unit), f->lid};

@@ -66,6 +66,16 @@
 // that moves its FDP the wrong way, or by less than a FAP unit, gets no
 // target.
 //
+// Helpers (steer.h; FapMapping::helpers): where a group's pose, at the
+// value or at its cap, moves the FDP off the FAP's direction by more than
+// kSteerAbove of the prescribed motion, the row's helpers join the group at
+// contractions chosen to cancel that motion, and the group is solved again
+// under the same load control from the pose reached (up to kSteerRounds
+// solves). A round is kept only where the off-axis motion falls, the group
+// reaches no less than before, and the skin sinks and tears no more; the
+// outcome's message names the helpers. FapSynthesisOptions::steer = false
+// leaves the groups alone.
+//
 // What is measured per target (the fidelity report): the prescribed FDP
 // displacement, the achieved one, the error along the FAP's direction and
 // off it, both relative to the prescribed length. Along the direction the
@@ -121,6 +131,9 @@ struct FapSynthesisOptions {
   std::vector<int> only_visemes;  // 1..14
   std::vector<int> only_expressions;  // 1..6
   bool negative_sides = true;     // make the negative side's own target where the table has one
+  // Let helpers steer a group's FDP back onto the FAP's direction (steer.h);
+  // false: the table's groups act alone.
+  bool steer = true;
   // Workers (0: one per core). The targets are the same for any number.
   int threads = 0;
   // The simulation mesh the model was built on (sim_mesh.h), when it is

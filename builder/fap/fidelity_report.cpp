@@ -134,8 +134,7 @@ std::string fidelity_table(const FapSynthesis &s) {
     if (o.reached < 1) reach.push_back(o.reached);
     out += format("%-4s %-34s %6d %8.3f %10.4g %10.4g %7.2f%% %7.1f%% %7d %6d%s%s\n", id.c_str(), name.c_str(),
                   o.reference, o.scale, o.prescribed.norm(), o.achieved.norm(), 100 * o.along_error,
-                  100 * o.off_axis, o.dynamic, o.turned, o.reached < 1 ? "  " : "",
-                  o.reached < 1 ? o.message.c_str() : "");
+                  100 * o.off_axis, o.dynamic, o.turned, o.message.empty() ? "" : "  ", o.message.c_str());
   }
   out += format("targets: %zu made, %d not made; FAPs along the direction median %.2f%% worst %.2f%%; off-axis "
                 "median %.1f%% worst %.1f%%; %zu under-reach (median %.0f%% of the prescribed motion); %d turn "

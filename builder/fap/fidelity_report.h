@@ -31,7 +31,9 @@ namespace afmb {
 // "raise_l_cornerlip (negative)"), "viseme p, b, m", or the expression's.
 std::string target_label(const FapOutcome &outcome);
 
-// The table: a line per attempted target, then one summary line: targets
+// The table: a line per attempted target, ending in its outcome's message
+// where it has one (why it was not made, how far it under-reaches, which
+// helpers steered it, what was untangled), then one summary line: targets
 // made and not, and over the FAP targets the median and worst error along
 // the direction and off it.
 std::string fidelity_table(const FapSynthesis &synthesis);

@@ -84,6 +84,9 @@ void usage(FILE *out) {
       "                          calibrates only the muscles they use (and those of\n"
       "                          --contract and --influence), and the jaw when one opens\n"
       "                          it or --jaw does: the targets are the same\n"
+      "  --no-steer              each FAP's muscle group acts alone: no helper muscles\n"
+      "                          steer its FDP back onto the FAP's direction\n"
+      "                          (--list-faps names each FAP's helpers)\n"
       "  --report DIR            with -o, also write the fidelity report into DIR:\n"
       "                          report.txt, report.csv, a picture per target\n"
       "                          (targets/*.png), a contact sheet (sheet.png) and\n"
@@ -249,6 +252,8 @@ int main(int argc, char **argv) {
         so.only.push_back(static_cast<int>(n));
         at = comma + 1;
       }
+    } else if (a == "--no-steer") {
+      so.steer = false;
     } else if (a == "--report") {
       report_dir = value("--report");
     } else if (a == "--list-faps") {

@@ -37,6 +37,14 @@ r="$tmp/report"
   [ "$(wc -l <"$r/report.txt")" -eq 7 ] || fail "report.txt is not the printed table: $(cat "$r/report.txt")"
 [ "$(grep -c '^[a-z]*,' "$r/report.csv")" -eq 6 ] || fail "report.csv: not a header and 5 rows: $(cat "$r/report.csv")"
 grep -q '^viseme,10,"viseme A:",1,63,1,1,' "$r/report.csv" || fail "report.csv: no viseme A: row"
+# Helpers steer the raised corner back onto FAP 12's direction, and the
+# message names them; with --no-steer the group acts alone.
+grep -q '^fap,12,"raise_l_cornerlip",1,.*steered by .*orbicularis_oris' "$r/report.csv" ||
+  fail "report.csv: FAP 12 not steered: $(grep '^fap,12' "$r/report.csv")"
+"$bin" "$tmp/h.wrl" "$tmp/h.fdp" -q --faps 12 --no-steer -o "$tmp/alone.afm" --report "$tmp/alone" \
+  >"$tmp/alone.txt" 2>&1 || fail "a build with --no-steer failed: $(cat "$tmp/alone.txt")"
+grep -q '^fap,12,"raise_l_cornerlip",1,' "$tmp/alone/report.csv" && ! grep -q steered "$tmp/alone/report.csv" ||
+  fail "--no-steer: $(grep '^fap,12' "$tmp/alone/report.csv")"
 # The contact sheet: neutral and 5 targets of 240 x 288 in one row, 4-pixel gaps.
 for t in neutral fap03 fap12 fap12-neg viseme10 expression1; do
   [ -s "$r/targets/$t.png" ] || fail "no picture targets/$t.png"
