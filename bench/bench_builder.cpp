@@ -1,7 +1,8 @@
 // Builder benchmarks (issues 4 and 5): the full model build (25 muscles and
 // the jaw calibrated), the FAP targets and the AFM (the whole job of
 // afm-build -o) on the skin and on afm-build's default simulation mesh,
-// time to equilibrium per muscle, dynamic sets against whole-mesh solves,
+// there also with each muscle group alone (no helpers, fap/steer.h), time
+// to equilibrium per muscle, dynamic sets against whole-mesh solves,
 // iterations when the epidermis is 10 times stiffer, and the paper's solver
 // beside the others, all in one run.
 //
@@ -29,6 +30,15 @@ namespace {
 // of the brow, the mouth's sphincter.
 const char *kCompared[] = {"zygomaticus_major_left", "corrugator_left", "orbicularis_oris"};
 
+// The median off-axis share of a synthesis' FAP targets, percent.
+double off_median(const FapSynthesis &f) {
+  std::vector<double> off;
+  for (const FapOutcome &o : f.outcomes)
+    if (o.made && o.kind == AFM_TARGET_FAP) off.push_back(o.off_axis);
+  std::sort(off.begin(), off.end());
+  return off.empty() ? 0.0 : 100 * off[off.size() / 2];
+}
+
 double now() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
@@ -51,10 +61,7 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
   Expected<FapSynthesis> syn = synthesize_faps(scene, *m);
   if (syn) {
     const double t_targets = now() - t1;
-    std::vector<double> off;
-    for (const FapOutcome &o : syn->outcomes)
-      if (o.made && o.kind == AFM_TARGET_FAP) off.push_back(o.off_axis);
-    std::sort(off.begin(), off.end());
+    const double off = off_median(*syn);
     const size_t made = syn->targets.size(), tried = syn->outcomes.size();
     Expected<std::vector<uint8_t>> bytes =
         encode_afm(fap_afm_content(scene, fdps, *m, std::move(*syn)), AFM_PROFILE_DRACO);
@@ -62,7 +69,7 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
                 "%.0f %%\n",
                 made, tried, t_targets,
                 bytes ? (std::to_string(bytes->size()) + " bytes").c_str() : bytes.status().message().c_str(),
-                now() - t0, off.empty() ? 0.0 : 100 * off[off.size() / 2]);
+                now() - t0, off);
   } else {
     std::printf("FAP targets failed: %s\n", syn.status().message().c_str());
   }
@@ -74,8 +81,11 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
     Expected<SimFaceModel> s = build_sim_face_model(scene, fdps, SimMeshOptions{kDefaultSimVertices}, FaceModelOptions{});
     FapSynthesisOptions so;
     if (s) so.sim = &s->sim;
+    const double t3 = now();
     Expected<FapSynthesis> st = s ? synthesize_faps(s->scene, s->model, so) : Expected<FapSynthesis>(s.status());
+    const double t_steered = now() - t3;
     if (st) {
+      const double off_steered = off_median(*st);
       size_t under = 0;
       for (const FapOutcome &o : st->outcomes) under += o.made && o.reached < 1;
       Expected<std::vector<uint8_t>> bytes =
@@ -85,6 +95,17 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
                   "skin; AFM %s; %zu targets under-reach\n",
                   s->sim.kept.size(), s->notes.size(), t, whole_skin / t,
                   bytes ? (std::to_string(bytes->size()) + " bytes").c_str() : bytes.status().message().c_str(), under);
+      // The same targets with each group alone (no helpers steering the
+      // FDP onto the FAP's direction, fap/steer.h): what the steering costs.
+      FapSynthesisOptions alone = so;
+      alone.steer = false;
+      const double t4 = now();
+      Expected<FapSynthesis> sa = synthesize_faps(s->scene, s->model, alone);
+      const double t_alone = now() - t4;
+      if (sa)
+        std::printf("on the simulation mesh, FAP targets with helpers %.2f s (off-axis median %.1f %%), the groups "
+                    "alone %.2f s (%.1f %%): %.2fx the time\n",
+                    t_steered, off_steered, t_alone, off_median(*sa), t_steered / t_alone);
     } else {
       std::printf("on the simulation mesh: failed: %s\n", st.status().message().c_str());
     }
