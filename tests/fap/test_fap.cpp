@@ -113,10 +113,11 @@ const Built &head_1k() {
   if (!b) {
     FaceModelOptions fo;
     // FAP 12's helpers (fap_mapping.cpp) too: zygomaticus minor, the upper
-    // lip, risorius and orbicularis oris.
+    // lip, risorius and orbicularis oris; and nasalis for FAP 61, whose
+    // helpers are the upper lip and zygomaticus minor.
     fo.calibrate_only = {"zygomaticus_major_left", "depressor_anguli_left", "frontalis_major_left", "corrugator_left",
                          "mentalis_left", "mentalis_right", "zygomaticus_minor_left", "upper_lip_left",
-                         "risorius_left", "orbicularis_oris"};
+                         "risorius_left", "orbicularis_oris", "nasalis_left"};
     b = afmtest::build_reference_model(1000, fo);
   }
   return *b;
@@ -396,6 +397,44 @@ TEST(FapSynthesis, HelpersSteerTheRaisedCornerBackOntoTheFapsDirection) {
   EXPECT_NE(steered.outcome.message.find("steered by"), std::string::npos) << steered.outcome.message;
   std::printf("FAP 12 on the 1k head, off-axis share alone %.2f, steered %.2f (%s)\n", off_axis(alone.at_corner) / value,
               off_axis(steered.at_corner) / value, steered.outcome.message.c_str());
+}
+
+// A group that falls short of its FAP is steered toward the whole
+// prescribed motion: on the 1k head nasalis alone widens the nostril (FAP
+// 61) to under half its prescription and moves it further than that off
+// the direction; with zygomaticus minor helping it gets further along and
+// nearer the direction. Measured from the targets at the FAP's FDP.
+TEST(FapSynthesis, HelpersTakeAnUnderReachingGroupFurtherAndNearerItsDirection) {
+  const FaceModel &m = head_1k().model;
+  const afm_fap_info *info = afm_fap(61);
+  const Eigen::Vector3d dir = direction_of(61);
+  const double value = 100 * fapu_distance(m.fapu, info->unit) / 1024.0;
+  auto make = [&](bool steer) {
+    FapSynthesisOptions o;
+    o.only = {61};
+    o.negative_sides = false;
+    o.steer = steer;
+    Expected<FapSynthesis> r = synthesize_faps(head_1k().head.scene, m, o);
+    EXPECT_TRUE(r.is_ok()) << r.status().message();
+    std::pair<FapOutcome, Eigen::Vector3d> out;
+    if (!r.is_ok() || r->targets.size() != 1) return out;
+    out = {r->outcomes[0], at_fdp(r->targets[0], info->fdp_group, info->fdp_index)};
+    return out;
+  };
+  const auto [alone, d_alone] = make(false);
+  const auto [steered, d_steered] = make(true);
+  ASSERT_FALSE(HasFailure());
+  auto off_axis = [&dir](const Eigen::Vector3d &d) { return (d - d.dot(dir) * dir).norm(); };
+  EXPECT_LT(d_alone.dot(dir), 0.6 * value) << "the group alone reaches its prescription: " << alone.message;
+  EXPECT_GT(off_axis(d_alone), 0.5 * value);
+  EXPECT_GT(d_steered.dot(dir), d_alone.dot(dir) + 0.1 * value) << steered.message;
+  EXPECT_LT(off_axis(d_steered), 0.8 * off_axis(d_alone)) << steered.message;
+  EXPECT_LT((d_steered - value * dir).norm(), (d_alone - value * dir).norm());
+  EXPECT_NE(steered.message.find("zygomaticus_minor_left"), std::string::npos) << steered.message;
+  EXPECT_NEAR(steered.reached, d_steered.dot(dir) / value, 1e-9);
+  std::printf("FAP 61 on the 1k head, alone: %.0f %% along, %.0f %% off; steered: %.0f %% along, %.0f %% off (%s)\n",
+              100 * d_alone.dot(dir) / value, 100 * off_axis(d_alone) / value, 100 * d_steered.dot(dir) / value,
+              100 * off_axis(d_steered) / value, steered.message.c_str());
 }
 
 // Viseme A: opens the jaw by its table's FAP 3 value: the chin drops by
