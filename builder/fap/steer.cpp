@@ -130,7 +130,8 @@ std::string steer_group(const FaceModel &model, const std::vector<std::string> &
   };
   SteerModel linear = steer_model(columns, measured, along);
   std::vector<double> c(columns.size(), 0);
-  const double off_start = (off_axis * motion(pose)).norm();
+  const Eigen::Vector3d m0 = motion(pose);
+  const double off_start = (off_axis * m0).norm();
   double off_now = off_start;
   std::optional<Faults> faults_now;
   for (int round = 0; round < kSteerRounds && off_now > kSteerAbove * value; ++round) {
@@ -186,8 +187,15 @@ std::string steer_group(const FaceModel &model, const std::vector<std::string> &
   }
   if (out.empty()) return out;
   char b[96];
-  std::snprintf(b, sizeof b, " (off-axis %.0f %% -> %.0f %%)", 100 * off_start / value, 100 * off_now / value);
-  return "steered by " + out + b;
+  std::snprintf(b, sizeof b, " (off-axis %.0f %% -> %.0f %%", 100 * off_start / value, 100 * off_now / value);
+  out = "steered by " + out + b;
+  // A group short of its value may have got further along.
+  const double along0 = m0.dot(along), along1 = motion(pose).dot(along);
+  if (along1 > along0 + model.solver.tolerance) {
+    std::snprintf(b, sizeof b, ", along %.0f %% -> %.0f %%", 100 * along0 / value, 100 * along1 / value);
+    out += b;
+  }
+  return out + ")";
 }
 
 }  // namespace afmb

@@ -124,8 +124,9 @@ void steer_update(SteerModel &model, const std::vector<double> &from, const std:
 // gains less, a failed solve, or kSteerRounds rounds. Out: the pose,
 // scale and capped of the last round kept (as they were when none is).
 // Returns "steered by NAME +C %, ... (off-axis A % -> B %)", contractions
-// in percent of each helper's range and off-axis shares of `value`, or ""
-// when no round was kept.
+// in percent of each helper's range and off-axis shares of `value` (with
+// ", along A % -> B %" where a group short of its value got further), or
+// "" when no round was kept.
 std::string steer_group(const FaceModel &model, const std::vector<std::string> &names,
                         const std::vector<std::pair<int, double>> &pattern, int vertex, const Eigen::Vector3d &along,
                         const PoseAction &action, double value, double cap, FactorCache *cache,

@@ -431,6 +431,8 @@ TEST(FapSynthesis, HelpersTakeAnUnderReachingGroupFurtherAndNearerItsDirection) 
   EXPECT_LT(off_axis(d_steered), 0.8 * off_axis(d_alone)) << steered.message;
   EXPECT_LT((d_steered - value * dir).norm(), (d_alone - value * dir).norm());
   EXPECT_NE(steered.message.find("zygomaticus_minor_left"), std::string::npos) << steered.message;
+  EXPECT_NE(steered.message.find(", along "), std::string::npos) << "the message says how far it got: "
+                                                                  << steered.message;
   EXPECT_NEAR(steered.reached, d_steered.dot(dir) / value, 1e-9);
   std::printf("FAP 61 on the 1k head, alone: %.0f %% along, %.0f %% off; steered: %.0f %% along, %.0f %% off (%s)\n",
               100 * d_alone.dot(dir) / value, 100 * off_axis(d_alone) / value, 100 * d_steered.dot(dir) / value,
