@@ -110,9 +110,11 @@ std::vector<FapMapping> make_table() {
     add(f, D::None, 0, {}, {}, "human ears do not move: the auricular muscles are vestigial");
   std::sort(t.begin(), t.end(), [](const FapMapping &a, const FapMapping &b) { return a.fap < b.fap; });
   // Helpers (fap_mapping.h): the muscles beside the group's that move its
-  // FDP, each FAP's own side's. Left out: the lids (they follow the
-  // eyeball, and so does their off-axis motion), pushing the lips and the
-  // chin (nothing behind the lips to push against), bending the nose.
+  // FDP, on the FAP's own side, and orbicularis oris, which spans both (its
+  // cost, steer.h, counts the whole face it moves). Left out: the lids
+  // (they follow the eyeball, and so does their off-axis motion), pushing
+  // the lips and the chin (nothing behind the lips to push against),
+  // bending the nose.
   auto help = [&t](int fap, std::vector<std::string> names) {
     t[static_cast<size_t>(fap - 3)].helpers = std::move(names);
   };

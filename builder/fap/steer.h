@@ -5,7 +5,7 @@
 // moves the skin along its own line of action and along the bone. Alone,
 // zygomaticus major raises Song's mouth corner and pulls it out toward the
 // cheekbone by a third of the rise; with risorius let back and orbicularis
-// oris drawing the corner in, a twelfth is left. The report's off-axis
+// oris drawing the corner in, an eighth is left. The report's off-axis
 // median on Song went from 25 to 14 % (docs/fap_mapping.md).
 //
 // The choice (steer_contractions): with r+ and r- a helper's calibrated
