@@ -118,7 +118,11 @@ void steer_update(SteerModel &model, const std::vector<double> &from, const std:
 // and solves the group with them from it, under the same load control; a
 // round is kept only where the FDP's off-axis motion falls, the group
 // reaches no less than before (a capped group no less far along), and the
-// skin sinks and tears no more. After a round not kept the model is
+// skin sinks and tears no more. Folds are allowed, past the calibrated
+// range too: the few a steered pose turns there (Song: 2-8 triangles, each
+// under 1e-4 of the skin's area) the split of shared skin and the
+// untangling take out (fap_synthesis.h), and requiring none cost Song 2
+// points of its off-axis median. After a round not kept the model is
 // corrected and the choice made again; the steering stops after a round
 // that gains less than kSteerGain of `value`, a choice the model says
 // gains less, a failed solve, or kSteerRounds rounds. Out: the pose,
