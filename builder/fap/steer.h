@@ -119,8 +119,8 @@ void steer_update(SteerModel &model, const std::vector<double> &from, const std:
 // round is kept only where the FDP's off-axis motion falls, the group
 // reaches no less than before (a capped group no less far along), and the
 // skin sinks and tears no more. Folds are allowed, past the calibrated
-// range too: the few a steered pose turns there (Song: 2-8 triangles, each
-// under 1e-4 of the skin's area) the split of shared skin and the
+// range too: the few a steered pose turns there (Song: 2-8 triangles, in
+// all under 5e-5 of the skin's area) the split of shared skin and the
 // untangling take out (fap_synthesis.h), and requiring none cost Song 2
 // points of its off-axis median. After a round not kept the model is
 // corrected and the choice made again; the steering stops after a round
