@@ -354,6 +354,29 @@ TEST(Steer, TheChoiceCancelsTheOffAxisMotionWithinItsBoundsAndTheSecantMeetsWhat
   EXPECT_EQ(model.column[0], Eigen::Vector3d(1, 0, 0)) << "a variable the step did not move keeps its column";
 }
 
+// FAP `fap`'s positive target on the 1k head, made alone, with the helpers
+// steering (fap/steer.h) or without; `made` false, with a test failure,
+// when it is not made.
+struct Solo {
+  bool made = false;
+  FapOutcome outcome;
+  MorphTarget target;
+};
+Solo solo_target(int fap, bool steer) {
+  FapSynthesisOptions o;
+  o.only = {fap};
+  o.negative_sides = false;
+  o.steer = steer;
+  Expected<FapSynthesis> r = synthesize_faps(head_1k().head.scene, head_1k().model, o);
+  EXPECT_TRUE(r.is_ok()) << r.status().message();
+  Solo out;
+  if (!r.is_ok()) return out;
+  EXPECT_EQ(r->targets.size(), 1u) << "FAP " << fap;
+  if (r->targets.size() != 1) return out;
+  out = {true, r->outcomes[0], r->targets[0]};
+  return out;
+}
+
 // Alone, zygomaticus major raises the 1k head's mouth corner and pulls it
 // out toward the cheekbone by nearly half the rise; its helpers
 // (fap_mapping.cpp) pull it back, and the corner still rises by FAP 12's
@@ -370,17 +393,12 @@ TEST(FapSynthesis, HelpersSteerTheRaisedCornerBackOntoTheFapsDirection) {
     int turned = -1;
   };
   auto make = [&](bool steer) {
-    FapSynthesisOptions o;
-    o.only = {12};
-    o.negative_sides = false;
-    o.steer = steer;
-    Expected<FapSynthesis> r = synthesize_faps(head_1k().head.scene, m, o);
-    EXPECT_TRUE(r.is_ok()) << r.status().message();
+    const Solo t = solo_target(12, steer);
     Made made;
-    if (!r.is_ok() || r->targets.size() != 1) return made;
-    made.outcome = r->outcomes[0];
-    made.at_corner = at_fdp(r->targets[0], 2, 4);
-    made.turned = turned_over(rest, m.tissue.F, rest + r->targets[0].displacement[static_cast<size_t>(m.skin)]);
+    if (!t.made) return made;
+    made.outcome = t.outcome;
+    made.at_corner = at_fdp(t.target, 2, 4);
+    made.turned = turned_over(rest, m.tissue.F, rest + t.target.displacement[static_cast<size_t>(m.skin)]);
     return made;
   };
   const Made alone = make(false), steered = make(true);
@@ -410,15 +428,9 @@ TEST(FapSynthesis, HelpersTakeAnUnderReachingGroupFurtherAndNearerItsDirection) 
   const Eigen::Vector3d dir = direction_of(61);
   const double value = 100 * fapu_distance(m.fapu, info->unit) / 1024.0;
   auto make = [&](bool steer) {
-    FapSynthesisOptions o;
-    o.only = {61};
-    o.negative_sides = false;
-    o.steer = steer;
-    Expected<FapSynthesis> r = synthesize_faps(head_1k().head.scene, m, o);
-    EXPECT_TRUE(r.is_ok()) << r.status().message();
+    const Solo t = solo_target(61, steer);
     std::pair<FapOutcome, Eigen::Vector3d> out;
-    if (!r.is_ok() || r->targets.size() != 1) return out;
-    out = {r->outcomes[0], at_fdp(r->targets[0], info->fdp_group, info->fdp_index)};
+    if (t.made) out = {t.outcome, at_fdp(t.target, info->fdp_group, info->fdp_index)};
     return out;
   };
   const auto [alone, d_alone] = make(false);
