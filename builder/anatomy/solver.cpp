@@ -966,6 +966,21 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
       if ((std::isfinite(e) && e <= e0 - 1e-4 * alpha * std::max(slope, 0.0)) || ls == 11) break;
       alpha *= 0.5;
     }
+    // A whole step on the projected (or shifted) tangent may fall short: that
+    // tangent is stiffer than the skin along a mode the compressed springs
+    // soften, and Newton then crawls along it a step of the same length at a
+    // time (the 10k head's zygomaticus major: 32 iterations). Twice, four and
+    // eight times the step are tried while the energy keeps falling.
+    if (options.extend_steps && !full && alpha == 1) {
+      double e_best = total_energy(sys, next_load, reference, Xt);
+      for (double longer : {2.0, 4.0, 8.0}) {
+        const Vec further = x0 + longer * dx;
+        scatter_rows(sys, further, Xt);
+        const double e = total_energy(sys, next_load, reference, Xt);
+        if (!(std::isfinite(e) && e < e_best)) break;
+        e_best = e, trial = further, alpha = longer;
+      }
+    }
     if (!finite(trial)) return done(false, name + ": non-finite step");
     scatter_rows(sys, trial, X);
     st.last_step = alpha * max_node_motion(dx);

@@ -57,6 +57,12 @@
 //                   factorisation's worth stops and the step starts over
 //                   with a fresh one. The fill-reducing
 //                   ordering is computed once per dynamic set (FactorCache).
+//                   A backtracking (Armijo) line search on the total energy;
+//                   a whole step made on the projected or shifted tangent,
+//                   which is stiffer than the skin along the modes that
+//                   compressed springs soften, is also tried at 2, 4 and 8
+//                   times its length while the energy keeps falling
+//                   (SolverOptions::extend_steps).
 //                   The default: fastest in bench_builder.
 //   newton-rest     the same, preconditioned by one factorisation of the
 //                   rest-state Hessian of the set, shared by every solve on
@@ -123,6 +129,10 @@ struct SolverOptions {
   // system's own time t0 = sqrt(mean mass / mean stiffness diagonal).
   double time_step = 20.0;
   double damping = 0.5;
+  // newton solvers: a whole step made on the projected or shifted tangent
+  // that the line search accepts is tried again at 2, 4 and 8 times its
+  // length while the total energy keeps falling (see "newton" above).
+  bool extend_steps = true;
 };
 
 struct SolveStats {

@@ -989,6 +989,37 @@ TEST(Solver, NeverReportsAnUnconvergedResultAsConverged) {
   EXPECT_TRUE(X.allFinite());
 }
 
+TEST(Solver, LongerStepsCutTheCrawlOnAStiffSkin) {
+  // bench_builder's stiffness case on the 1k head: the epidermis 10 times
+  // stiffer. Frontalis inner pulls the forehead up; Newton's steps on the
+  // projected tangent fall short along the mode the compressed springs
+  // soften. Tried at 2, 4 and 8 times their length while the energy falls,
+  // they reach the same equilibrium in fewer iterations (19 -> 13 when
+  // this was written; switched off, the last check fails).
+  const Built &b = head_1k();
+  FaceModelOptions fo;
+  fo.calibrate = false;
+  fo.tissue.slab[0].modulus *= 10;
+  Expected<FaceModel> m = build_face_model(b.head.scene, b.head.fdps, fo);
+  ASSERT_TRUE(m.is_ok()) << m.status().message();
+  const Muscle &mu = m->muscles[static_cast<size_t>(m->find("frontalis_inner_right"))];
+  ForceField f = [&](const Eigen::MatrixXd &X, Eigen::MatrixXd *F, NodeBlocks *K) {
+    return muscle_load(m->tissue, mu, 2.0, X, F, K);
+  };
+  SolveStats st[2];
+  Eigen::MatrixXd X[2];
+  for (int extend = 0; extend < 2; ++extend) {
+    SolverOptions so = m->solver;
+    so.extend_steps = extend == 1;
+    X[extend] = m->tissue.X0;
+    FactorCache cache;
+    st[extend] = solve_equilibrium(m->tissue, all_vertices(m->tissue), f, m->tissue.X0, X[extend], so, &cache);
+    ASSERT_TRUE(st[extend].converged) << st[extend].message;
+  }
+  EXPECT_LT((X[1] - X[0]).cwiseAbs().maxCoeff(), m->quantum);
+  EXPECT_LT(st[1].iterations, st[0].iterations);
+}
+
 TEST(Solver, ALoadThatMovesTheActionTheWrongWayFailsAtOnce) {
   // Load control from a tension already found (a solve beyond a FAP's
   // range starts so): the step clamp halves the tension each iteration
