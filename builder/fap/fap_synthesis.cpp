@@ -194,7 +194,10 @@ void measure(FapOutcome &o, const Eigen::Vector3d &achieved, const Eigen::Vector
   const double len = o.prescribed.norm();
   const double a = o.achieved.dot(dir);
   o.along_error = std::abs(a - o.prescribed.dot(dir)) / len;
-  o.off_axis = (o.achieved - a * dir).norm() / len;
+  const Eigen::Vector3d off = o.achieved - a * dir;
+  o.off_axis = off.norm() / len;
+  o.off_face = off.head<2>().norm() / len;
+  o.off_depth = std::abs(off.z()) / len;
 }
 
 std::string high_level_label(const HighLevelMapping &h) {

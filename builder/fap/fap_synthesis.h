@@ -112,6 +112,10 @@ struct FapOutcome {
   Eigen::Vector3d achieved = Eigen::Vector3d::Zero();
   double along_error = 0;         // |achieved . dir - prescribed . dir| / |prescribed|
   double off_axis = 0;            // |achieved - (achieved . dir) dir| / |prescribed|
+  // The off-axis motion split (off_axis^2 = off_face^2 + off_depth^2):
+  // across the face, its x and y in the MPEG-4 frame (what a frontal view
+  // shows), and in depth, its z (toward the viewer or back).
+  double off_face = 0, off_depth = 0;
   // Visemes and expressions have no FDP rule: prescribed, achieved and the
   // errors stay zero; `largest` says how far the face moved.
   double largest = 0;             // the largest skin vertex displacement, model units

@@ -110,7 +110,7 @@ std::string target_label(const FapOutcome &o) {
 std::string fidelity_table(const FapSynthesis &s) {
   std::string out = format("%-4s %-34s %6s %8s %10s %10s %8s %8s %7s %6s\n", "fap", "name", "ref", "scale",
                            "prescribed", "achieved", "along", "off-axis", "V_d", "turned");
-  std::vector<double> along, off, reach;
+  std::vector<double> along, off, off_face, off_depth, reach;
   int failed = 0, turning = 0, turned = 0;
   for (const FapOutcome &o : s.outcomes) {
     const std::string id = target_id(o);
@@ -131,16 +131,20 @@ std::string fidelity_table(const FapSynthesis &s) {
     }
     along.push_back(o.along_error);
     off.push_back(o.off_axis);
+    off_face.push_back(o.off_face);
+    off_depth.push_back(o.off_depth);
     if (o.reached < 1) reach.push_back(o.reached);
     out += format("%-4s %-34s %6d %8.3f %10.4g %10.4g %7.2f%% %7.1f%% %7d %6d%s%s\n", id.c_str(), name.c_str(),
                   o.reference, o.scale, o.prescribed.norm(), o.achieved.norm(), 100 * o.along_error,
                   100 * o.off_axis, o.dynamic, o.turned, o.message.empty() ? "" : "  ", o.message.c_str());
   }
   out += format("targets: %zu made, %d not made; FAPs along the direction median %.2f%% worst %.2f%%; off-axis "
-                "median %.1f%% worst %.1f%%; %zu under-reach (median %.0f%% of the prescribed motion); %d turn "
-                "%d skin triangles over (visemes and expressions: achieved = largest motion)\n",
+                "median %.1f%% worst %.1f%% (across the face median %.1f%%, in depth %.1f%%); %zu under-reach "
+                "(median %.0f%% of the prescribed motion); %d turn %d skin triangles over (visemes and "
+                "expressions: achieved = largest motion)\n",
                 s.targets.size(), failed, 100 * median(along), 100 * worst(along), 100 * median(off),
-                100 * worst(off), reach.size(), 100 * median(reach), turning, turned);
+                100 * worst(off), 100 * median(off_face), 100 * median(off_depth), reach.size(),
+                100 * median(reach), turning, turned);
   return out;
 }
 
@@ -157,13 +161,14 @@ Status write_fidelity_report(const std::string &dir, const Scene &scene, const F
   if (Status st = write_file_atomic(dir + sep + "report.txt", table); !st) return st;
   std::string csv =
       "kind,number,name,side,reference,reached,made,scale,prescribed_x,prescribed_y,prescribed_z,achieved_x,"
-      "achieved_y,achieved_z,along_error,off_axis,largest,dynamic,turned,seconds,message\n";
+      "achieved_y,achieved_z,along_error,off_axis,off_face,off_depth,largest,dynamic,turned,seconds,message\n";
   for (const FapOutcome &o : s.outcomes)
-    csv += format("%s,%d,%s,%d,%d,%.4g,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%.3f,",
+    csv += format("%s,%d,%s,%d,%d,%.4g,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%.3f,",
                   o.kind == AFM_TARGET_FAP ? "fap" : o.kind == AFM_TARGET_VISEME ? "viseme" : "expression",
                   o.number, csv_quote(target_label(o)).c_str(), o.side, o.reference, o.reached, o.made ? 1 : 0,
                   o.scale, o.prescribed.x(), o.prescribed.y(), o.prescribed.z(), o.achieved.x(), o.achieved.y(),
-                  o.achieved.z(), o.along_error, o.off_axis, o.largest, o.dynamic, o.turned, o.seconds) +
+                  o.achieved.z(), o.along_error, o.off_axis, o.off_face, o.off_depth, o.largest, o.dynamic,
+                  o.turned, o.seconds) +
            csv_quote(o.message) + "\n";
   if (Status st = write_file_atomic(dir + sep + "report.csv", csv); !st) return st;
 
@@ -270,8 +275,10 @@ Status write_fidelity_report(const std::string &dir, const Scene &scene, const F
     } else if (o.kind != AFM_TARGET_FAP) {
       html += format("<td></td><td></td><td>%.4g</td><td></td><td></td>", o.largest);
     } else {
-      html += format("<td>%.3f</td><td>%.4g</td><td>%.4g</td><td>%.2f%%</td><td>%.1f%%</td>", o.scale,
-                     o.prescribed.norm(), o.achieved.norm(), 100 * o.along_error, 100 * o.off_axis);
+      html += format("<td>%.3f</td><td>%.4g</td><td>%.4g</td><td>%.2f%%</td><td>%.1f%% (%.1f%% across, %.1f%% "
+                     "depth)</td>",
+                     o.scale, o.prescribed.norm(), o.achieved.norm(), 100 * o.along_error, 100 * o.off_axis,
+                     100 * o.off_face, 100 * o.off_depth);
     }
     html += "<td class=\"l\">" + html_escape(o.made ? o.message : "not made: " + o.message) + "</td></tr>\n";
   }

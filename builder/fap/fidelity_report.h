@@ -1,7 +1,9 @@
 // The fidelity report of a FAP synthesis (issue 5, `afm-build --report DIR`):
 // per target, the prescribed against the achieved FDP displacement and the
-// errors along and off the FAP's direction, with the median and the worst;
-// and a picture of every target.
+// errors along and off the FAP's direction, with the median and the worst,
+// the off-axis error also split into its parts across the face (x, y of the
+// MPEG-4 frame: what a frontal view shows) and in depth (z); and a picture
+// of every target.
 //
 // Files written into DIR (created when missing; its parent must exist), each
 // atomically:
@@ -35,7 +37,8 @@ std::string target_label(const FapOutcome &outcome);
 // where it has one (why it was not made, how far it under-reaches, which
 // helpers steered it, what was untangled), then one summary line: targets
 // made and not, and over the FAP targets the median and worst error along
-// the direction and off it.
+// the direction and off it, and the medians of the off-axis parts across
+// the face and in depth.
 std::string fidelity_table(const FapSynthesis &synthesis);
 
 struct FidelityReportOptions {

@@ -37,6 +37,15 @@ r="$tmp/report"
   [ "$(wc -l <"$r/report.txt")" -eq 7 ] || fail "report.txt is not the printed table: $(cat "$r/report.txt")"
 [ "$(grep -c '^[a-z]*,' "$r/report.csv")" -eq 6 ] || fail "report.csv: not a header and 5 rows: $(cat "$r/report.csv")"
 grep -q '^viseme,10,"viseme A:",1,63,1,1,' "$r/report.csv" || fail "report.csv: no viseme A: row"
+# The off-axis error's parts across the face and in depth make it up
+# (squares add), and the summary gives their medians.
+grep -q "off-axis median [0-9.]*% worst [0-9.]*% (across the face median [0-9.]*%, in depth [0-9.]*%)" \
+  "$tmp/afm.txt" || fail "no off-axis parts in the summary: $(grep '^targets:' "$tmp/afm.txt")"
+awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) c[$i] = i; next }
+  $1 == "fap" { ++n; o = $c["off_axis"]; f = $c["off_face"]; d = $c["off_depth"]
+    if (f < 0 || d < 0 || (f * f + d * d - o * o) ^ 2 > 1e-8 * (o * o + 1e-12) ^ 2) bad = bad " " $2 }
+  END { exit (n != 3 || bad != "") }' "$r/report.csv" ||
+  fail "report.csv: off_face and off_depth do not make up off_axis: $(cat "$r/report.csv")"
 # Helpers steer the raised corner back onto FAP 12's direction, and the
 # message names them; with --no-steer the group acts alone.
 grep -q '^fap,12,"raise_l_cornerlip",1,.*steered by .*orbicularis_oris' "$r/report.csv" ||
