@@ -268,7 +268,7 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
   model.quantum = afm_position_quantum(scene);
   model.solver = options.solver;
   if (!(model.solver.tolerance > 0)) model.solver.tolerance = model.quantum / 2;
-  model.wave_threshold = options.wave_threshold > 0 ? options.wave_threshold : model.solver.tolerance;
+  model.wave_threshold = options.wave_threshold > 0 ? options.wave_threshold : kWaveQuanta * model.quantum;
   progress(4, steps_fixed, "solver ready");
   if (!options.calibrate) return model;
 
