@@ -44,10 +44,11 @@
 namespace afmb {
 
 // The default wave threshold, in AFM position quanta. The vertices left out
-// of a set would move less than that; the dynamic result stays within half
-// a quantum of the whole mesh's (0.40 on the 1k head's zygomaticus major,
-// 0.08 at half a quantum, tests/anatomy), and the sets are 9-25 % smaller
-// than at half a quantum (the three heads' whole AFMs: 14-26 % less time).
+// of a set would move less than that; the dynamic result stays within one
+// quantum of the whole mesh's (0.40 of one on the 1k head's zygomaticus
+// major, tests/anatomy; bench_builder up to 0.68 on Song; 0.08-0.20 at half
+// a quantum), and the sets are 9-25 % smaller than at half a quantum (the
+// three heads' whole AFMs: 14-26 % less CPU time; docs/anatomy.md).
 constexpr double kWaveQuanta = 2;
 
 struct FaceModelOptions {
