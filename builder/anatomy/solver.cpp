@@ -957,13 +957,13 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     if (control) rn += dt * [&] { Vec gf = g; contacts.filter(gf); return gf; }();
     x0 = gather_rows(sys, X);
     const double e0 = total_energy(sys, next_load, reference, X), slope = rn.dot(dx);
-    double alpha = 1;
+    double alpha = 1, e_trial = 0;
     Eigen::MatrixXd Xt = X;
     for (int ls = 0; ls < 12; ++ls) {
       trial = x0 + alpha * dx;
       scatter_rows(sys, trial, Xt);
-      const double e = total_energy(sys, next_load, reference, Xt);
-      if ((std::isfinite(e) && e <= e0 - 1e-4 * alpha * std::max(slope, 0.0)) || ls == 11) break;
+      e_trial = total_energy(sys, next_load, reference, Xt);
+      if ((std::isfinite(e_trial) && e_trial <= e0 - 1e-4 * alpha * std::max(slope, 0.0)) || ls == 11) break;
       alpha *= 0.5;
     }
     // A whole step on the projected (or shifted) tangent may fall short: that
@@ -972,7 +972,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     // time (the 10k head's zygomaticus major: 32 iterations). Twice, four and
     // eight times the step are tried while the energy keeps falling.
     if (options.extend_steps && !full && alpha == 1) {
-      double e_best = total_energy(sys, next_load, reference, Xt);
+      double e_best = e_trial;
       for (double longer : {2.0, 4.0, 8.0}) {
         const Vec further = x0 + longer * dx;
         scatter_rows(sys, further, Xt);
