@@ -397,4 +397,24 @@ void element_tet_volumes(const SkinModel &m, const Eigen::MatrixXd &X, int f, do
   }
 }
 
+std::vector<std::pair<int, int>> turned_slabs(const SkinModel &m, const Eigen::MatrixXd &X) {
+  const double depth[4] = {0, m.params.dermis_depth, m.params.hypodermis_depth, 1};
+  std::vector<std::pair<int, int>> out;
+  for (int f = 0; f < m.F.rows(); ++f) {
+    double rest[9], now[9];
+    element_tet_volumes(m, m.X0, f, rest);
+    element_tet_volumes(m, X, f, now);
+    bool tied = true;
+    for (int k = 0; k < 3; ++k) tied = tied && !m.skull_free[static_cast<size_t>(m.F(f, k))];
+    for (int slab = 0; slab < 3; ++slab) {
+      const double r = rest[3 * slab] + rest[3 * slab + 1] + rest[3 * slab + 2];
+      const double c = now[3 * slab] + now[3 * slab + 1] + now[3 * slab + 2];
+      if (std::abs(r) < 0.25 * (depth[slab + 1] - depth[slab]) * m.nominal_volume[f]) continue;
+      if (slab == 2 && !tied) continue;
+      if (r * c <= 0) out.emplace_back(f, slab);
+    }
+  }
+  return out;
+}
+
 }  // namespace afmb

@@ -32,6 +32,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "core/scene.h"
@@ -201,5 +202,16 @@ void element_volume_hessian(const SkinModel &m, const Eigen::MatrixXd &X, int f,
 // Per-tetrahedron signed volumes of element f: 9 values. An element is
 // inverted when one of its tetrahedra changed sign from the rest state.
 void element_tet_volumes(const SkinModel &m, const Eigen::MatrixXd &X, int f, double out[9]);
+
+// The slabs of the tissue turned through themselves at X (4n x 3): the
+// (element, slab 0..2) pairs whose signed volume (three tetrahedra) has the
+// other sign than at rest. Counted only where a slab holds tissue whose
+// facing its volume tells: not one seen edge-on from the centre (its rest
+// volume under a quarter of its depth's share of the element's nominal
+// volume: lip curls, nostrils), and not the bone slab under skin that is
+// not tied to the bone (lips, cheeks, lids: nothing lies between there).
+// Coarser than element_tet_volumes' test: a twisted slab may turn one of
+// its tetrahedra and keep its volume. Ascending by element.
+std::vector<std::pair<int, int>> turned_slabs(const SkinModel &m, const Eigen::MatrixXd &X);
 
 }  // namespace afmb
