@@ -31,6 +31,9 @@ namespace {
 // of the brow, the mouth's sphincter.
 const char *kCompared[] = {"zygomaticus_major_left", "corrugator_left", "orbicularis_oris"};
 
+// The collapse floor's modulus the bench weighs (afm-build --collapse-floor).
+constexpr double kBenchFloor = 0.3;
+
 // The median off-axis share of a synthesis' FAP targets, percent.
 double off_median(const FapSynthesis &f) {
   std::vector<double> off;
@@ -220,6 +223,36 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
               solver_name(m->solver.kind), its[0], its[1], change(its[0], its[1]), least, most,
               change(per_step(cgs[0], its[0]), per_step(cgs[1], its[1])),
               failed ? (", " + std::to_string(failed) + " did not converge").c_str() : "");
+
+  // The collapse floor (skin_model.h, TissueParams::collapse_modulus): every
+  // muscle at its calibrated +100 % tension on its set, without and with it.
+  FaceModelOptions floor_options;
+  floor_options.tissue.collapse_modulus = kBenchFloor;
+  floor_options.calibrate = false;
+  Expected<FaceModel> mf = build_face_model(scene, fdps, floor_options);
+  if (!mf) {
+    std::printf("floor build failed: %s\n", mf.status().message().c_str());
+    return false;
+  }
+  int floor_its[2] = {0, 0}, floor_failed = 0;
+  size_t floor_turned[2] = {0, 0};
+  for (const Muscle &mu : m->muscles)
+    for (int s = 0; s < 2; ++s) {
+      const FaceModel &fm = s == 0 ? *m : *mf;
+      ForceField f = [&](const Eigen::MatrixXd &X, Eigen::MatrixXd *F, NodeBlocks *K) {
+        return muscle_load(fm.tissue, mu, mu.tension_max, X, F, K);
+      };
+      Eigen::MatrixXd X = fm.tissue.X0;
+      FactorCache cache;
+      const SolveStats st = solve_equilibrium(fm.tissue, mu.dynamic, f, fm.tissue.X0, X, m->solver, &cache);
+      floor_its[s] += st.iterations;
+      floor_failed += !st.converged;
+      floor_turned[s] += turned_slabs(fm.tissue, X).size();
+    }
+  std::printf("collapse floor %.1f, every muscle at +100 %%: slabs turned %zu -> %zu, iterations %d -> %d (%+.0f %%)%s\n",
+              kBenchFloor, floor_turned[0], floor_turned[1], floor_its[0], floor_its[1],
+              change(floor_its[0], floor_its[1]),
+              floor_failed ? (", " + std::to_string(floor_failed) + " did not converge").c_str() : "");
   return true;
 }
 

@@ -156,6 +156,8 @@ Expected<SkinModel> build_skin_model(const Scene &scene, int part, const TissueP
       !(params.dermis_depth < params.hypodermis_depth) || !(params.hypodermis_depth < 1))
     return Status::error("skin model: need 0 < skull_scale < 1 and 0 < dermis_depth < "
                          "hypodermis_depth < 1");
+  if (!(params.collapse_modulus >= 0) || !(params.collapse_knee > 0 && params.collapse_knee <= 1))
+    return Status::error("skin model: need collapse_modulus >= 0 and 0 < collapse_knee <= 1");
 
   SkinModel m;
   m.part = part;
@@ -320,11 +322,11 @@ int nearest_node(const SkinModel &m, int layer, const Eigen::Vector3d &p) {
   return best < 0 ? -1 : m.node(layer, best);
 }
 
-double element_volume(const SkinModel &m, const Eigen::MatrixXd &X, int f,
-                      Eigen::Matrix<double, 9, 3> *gradient) {
+double element_volume(const SkinModel &m, const Eigen::MatrixXd &X, int f, Eigen::Matrix<double, 9, 3> *gradient,
+                      int only) {
   if (gradient) gradient->setZero();
   double v = 0;
-  for (int slab = 0; slab < 3; ++slab) {
+  for (int slab = std::max(only, 0); slab < (only < 0 ? 3 : only + 1); ++slab) {
     int node[6], row[6];
     slab_corners(m, f, slab, node, row);
     for (const auto &t : kTets) {
@@ -397,23 +399,25 @@ void element_tet_volumes(const SkinModel &m, const Eigen::MatrixXd &X, int f, do
   }
 }
 
-std::vector<std::pair<int, int>> turned_slabs(const SkinModel &m, const Eigen::MatrixXd &X) {
+double slab_nominal_volume(const SkinModel &m, int f, int slab) {
   const double depth[4] = {0, m.params.dermis_depth, m.params.hypodermis_depth, 1};
+  return (depth[slab + 1] - depth[slab]) * m.nominal_volume[f];
+}
+
+bool slab_holds_tissue(const SkinModel &m, int f, int slab) {
+  if (slab == 2)
+    for (int k = 0; k < 3; ++k)
+      if (m.skull_free[static_cast<size_t>(m.F(f, k))]) return false;
+  return std::abs(element_volume(m, m.X0, f, nullptr, slab)) >= 0.25 * slab_nominal_volume(m, f, slab);
+}
+
+std::vector<std::pair<int, int>> turned_slabs(const SkinModel &m, const Eigen::MatrixXd &X) {
   std::vector<std::pair<int, int>> out;
-  for (int f = 0; f < m.F.rows(); ++f) {
-    double rest[9], now[9];
-    element_tet_volumes(m, m.X0, f, rest);
-    element_tet_volumes(m, X, f, now);
-    bool tied = true;
-    for (int k = 0; k < 3; ++k) tied = tied && !m.skull_free[static_cast<size_t>(m.F(f, k))];
-    for (int slab = 0; slab < 3; ++slab) {
-      const double r = rest[3 * slab] + rest[3 * slab + 1] + rest[3 * slab + 2];
-      const double c = now[3 * slab] + now[3 * slab + 1] + now[3 * slab + 2];
-      if (std::abs(r) < 0.25 * (depth[slab + 1] - depth[slab]) * m.nominal_volume[f]) continue;
-      if (slab == 2 && !tied) continue;
-      if (r * c <= 0) out.emplace_back(f, slab);
-    }
-  }
+  for (int f = 0; f < m.F.rows(); ++f)
+    for (int slab = 0; slab < 3; ++slab)
+      if (slab_holds_tissue(m, f, slab) &&
+          element_volume(m, m.X0, f, nullptr, slab) * element_volume(m, X, f, nullptr, slab) <= 0)
+        out.emplace_back(f, slab);
   return out;
 }
 

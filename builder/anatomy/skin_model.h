@@ -64,6 +64,14 @@ struct TissueParams {
   // chosen).
   double volume_modulus = 0.02;
   double shape_modulus = 0.1;
+  // The collapse floor (solver.h), off at 0: a slab holding tissue
+  // (slab_holds_tissue) squeezed below `collapse_knee` of its rest volume
+  // has the energy collapse_modulus x its share of the element's nominal
+  // volume x ((knee - J) / knee)^3, J its volume over its rest volume, so
+  // that no slab turns through itself (0.3: none at +100 % of any muscle
+  // on the generated heads and Song; docs/anatomy.md gives the cost).
+  double collapse_modulus = 0.0;
+  double collapse_knee = 0.5;
   double density = 1.0;        // mass per volume, for the lumped masses
 };
 
@@ -187,12 +195,12 @@ Expected<SkinModel> build_skin_model(const Scene &scene, int part, const TissueP
 // a triangle; -1 when there are none.
 int nearest_node(const SkinModel &m, int layer, const Eigen::Vector3d &p);
 
-// Signed volume of element f (all three slabs, 9 tetrahedra) at positions X
-// (4n x 3), and optionally its gradient: 9 x 3, rows for the nodes
-// layer * 3 + corner of layers 0..2 (the skull's are not needed: it is fixed
-// or moved, never solved for).
+// Signed volume of element f (all three slabs, 9 tetrahedra; or, with
+// slab 0..2, that slab's 3) at positions X (4n x 3), and optionally its
+// gradient: 9 x 3, rows for the nodes layer * 3 + corner of layers 0..2
+// (the skull's are not needed: it is fixed or moved, never solved for).
 double element_volume(const SkinModel &m, const Eigen::MatrixXd &X, int f,
-                      Eigen::Matrix<double, 9, 3> *gradient = nullptr);
+                      Eigen::Matrix<double, 9, 3> *gradient = nullptr, int slab = -1);
 
 // The Hessian of element_volume(): 27 x 27, the 3 x 3 block (i, j) for the
 // gradient rows i and j (layers 0..2). Indefinite (the volume is cubic in
@@ -203,15 +211,22 @@ void element_volume_hessian(const SkinModel &m, const Eigen::MatrixXd &X, int f,
 // inverted when one of its tetrahedra changed sign from the rest state.
 void element_tet_volumes(const SkinModel &m, const Eigen::MatrixXd &X, int f, double out[9]);
 
+// Slab 0..2's share of element f's nominal volume (SkinModel::
+// nominal_volume), by the depths of its two surfaces.
+double slab_nominal_volume(const SkinModel &m, int f, int slab);
+
+// Whether slab 0..2 of element f holds tissue whose facing its volume
+// tells: not a slab seen edge-on from the centre (its rest volume under a
+// quarter of its depth's share of the element's nominal volume: lip curls,
+// nostrils), and not the bone slab under skin that is not tied to the bone
+// (lips, cheeks, lids: nothing lies between there).
+bool slab_holds_tissue(const SkinModel &m, int f, int slab);
+
 // The slabs of the tissue turned through themselves at X (4n x 3): the
-// (element, slab 0..2) pairs whose signed volume (three tetrahedra) has the
-// other sign than at rest. Counted only where a slab holds tissue whose
-// facing its volume tells: not one seen edge-on from the centre (its rest
-// volume under a quarter of its depth's share of the element's nominal
-// volume: lip curls, nostrils), and not the bone slab under skin that is
-// not tied to the bone (lips, cheeks, lids: nothing lies between there).
-// Coarser than element_tet_volumes' test: a twisted slab may turn one of
-// its tetrahedra and keep its volume. Ascending by element.
+// (element, slab) pairs that hold tissue and whose signed volume (three
+// tetrahedra) has the other sign than at rest. Coarser than
+// element_tet_volumes' test: a twisted slab may turn one of its tetrahedra
+// and keep its volume. Ascending by element.
 std::vector<std::pair<int, int>> turned_slabs(const SkinModel &m, const Eigen::MatrixXd &X);
 
 }  // namespace afmb

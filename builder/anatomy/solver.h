@@ -19,6 +19,13 @@
 //             k_s |V0| / R^2 (delta_ij - 1/12) I. `reference` is the
 //             unloaded shape: the rest state, or the rest state carried by
 //             the jaw for a jaw pose;
+//   floor     off unless TissueParams::collapse_modulus k_c > 0: per slab s
+//             that holds tissue (slab_holds_tissue), with J = V_s / V_s0,
+//             E_c = k_c V_nom,s ((j0 - J) / j0)^3 below the knee j0
+//             (collapse_knee), 0 above; V_nom,s the slab's depth share of
+//             the element's nominal volume. Its tangent is the Gauss-Newton
+//             part k_c V_nom,s psi''(J) / V_s0^2 dV_s/dp dV_s/dp^T only,
+//             in both forms;
 //             The tangent above is the full one. Its "projected" form drops
 //             the compressed springs' negative T / l and the volume's
 //             second-order part, and is positive semi-definite everywhere.

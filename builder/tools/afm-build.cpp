@@ -43,6 +43,10 @@ void usage(FILE *out) {
       "  --solver S              newton (default), newton-rest, implicit-euler (the\n"
       "                          paper's scheme) or newton-jacobi (solver.h; calibration\n"
       "                          always runs a newton solver)\n"
+      "  --collapse-floor K      resist each slab of tissue squeezed below half its\n"
+      "                          rest volume (modulus K, e.g. 0.3; default 0: off), so\n"
+      "                          that none turns through itself; slower, and the lips\n"
+      "                          move differently (docs/anatomy.md, \"Tissue\")\n"
       "  --sim-vertices N|full   simulate on a coarser copy of the skin of about N\n"
       "                          vertices (its own, every skin FDP among them; finer\n"
       "                          around eyes and mouth) and carry the motion to every\n"
@@ -178,6 +182,13 @@ int main(int argc, char **argv) {
       const std::string s = value("--solver");
       if (!solver_from_name(s, &fo.solver.kind))
         return usage_error("--solver '" + s + "': use newton, newton-rest, implicit-euler or newton-jacobi");
+    } else if (a == "--collapse-floor") {
+      const std::string k = value("--collapse-floor");
+      char *end = nullptr;
+      const double v = std::strtod(k.c_str(), &end);
+      if (k.empty() || *end || !(v >= 0 && v <= 100))
+        return usage_error("--collapse-floor '" + k + "': use a modulus, 0..100 (0: off)");
+      fo.tissue.collapse_modulus = v;
     } else if (a == "--threads") {
       const std::string t = value("--threads");
       char *end = nullptr;
@@ -397,9 +408,10 @@ int main(int argc, char **argv) {
       const double d = (E.row(v) - t.X0.row(v)).norm();
       if (d > worst) worst = d, at = v;
     }
-    std::printf("pose: %zu dynamic vertices, %d iterations (%d CG), %.3f s; largest motion %.4g at vertex %d\n",
+    std::printf("pose: %zu dynamic vertices, %d iterations (%d CG), %.3f s; largest motion %.4g at vertex %d; "
+                "%zu slabs of tissue turned through themselves\n",
                 pose->dynamic.size(), pose->stats.iterations, pose->stats.cg_iterations, pose->stats.seconds,
-                worst, at);
+                worst, at, turned_slabs(t, pose->X).size());
     if (!pose_png.empty()) {
       if (Status s = render_pose_png(scene, *model, *pose, jaw_motion(model->jaw, jaw_open, 0, 0), pose_png); !s)
         return fail(s);

@@ -546,6 +546,34 @@ TEST(Physics, MusclesAlongTheBoneMoveTheSkinAlongItsSurface) {
 // parts, which the generator made as spheres of known centre and radius.
 // Closing the eye hard presses the upper lid onto its eyeball; without the
 // contact the same pull takes the lid into it.
+// The collapse floor (TissueParams::collapse_modulus, solver.h): at a
+// tension that moves the brow or the upper lip about 10 mm on the 1k head,
+// the tissue alone turns slabs through themselves near the insertion; with
+// the floor none turns, and the skin moves nearly as far.
+TEST(Physics, TheCollapseFloorKeepsEverySlabUpright) {
+  const FaceModel &m = head_1k().model;
+  FaceModelOptions fo;
+  fo.calibrate = false;
+  fo.tissue.collapse_modulus = 0.3;
+  std::unique_ptr<Built> floored = afmtest::build_reference_model(1000, fo);
+  const FaceModel &f = floored->model;
+  for (const char *name : {"frontalis_inner_left", "upper_lip_left"}) {
+    SolveStats a, b;
+    const Eigen::MatrixXd X = contract(m, name, 0.5, &a), Y = contract(f, name, 0.5, &b);
+    const size_t without = turned_slabs(m.tissue, X).size(), with = turned_slabs(f.tissue, Y).size();
+    const double reach = (X - m.tissue.X0).rowwise().norm().maxCoeff(),
+                 floored_reach = (Y - f.tissue.X0).rowwise().norm().maxCoeff();
+    std::printf("%s at 0.5: %zu slabs turned (%d Newton iterations, %.1f mm), with the floor %zu (%d, %.1f mm)\n", name,
+                without, a.iterations, mm(reach), with, b.iterations, mm(floored_reach));
+    EXPECT_GT(without, 0u) << name << ": the case the floor is for";
+    EXPECT_EQ(with, 0u) << name;
+    EXPECT_TRUE(b.converged) << name << ": " << b.message;
+    EXPECT_TRUE(Y.allFinite());
+    EXPECT_EQ(penetrating_nodes(f.tissue, Y, 1e-9), 0) << name;
+    EXPECT_NEAR(floored_reach, reach, 0.1 * reach) << name;
+  }
+}
+
 TEST(Physics, TheLidsSlideOverTheEyeball) {
   const FaceModel &m = head_1k().model;
   const refhead::HeadDesign &design = refhead::head_design();

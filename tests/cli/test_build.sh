@@ -126,6 +126,7 @@ expect_error "percent out of range" 2 "within -100..100" - -- "$bin" "$h" "$f" -
 expect_error "bad contract" 2 "MUSCLE=PERCENT" - -- "$bin" "$h" "$f" --contract orbicularis_oris
 expect_error "bad solver" 2 "newton, newton-rest, implicit-euler" - -- "$bin" "$h" "$f" --solver magic
 expect_error "bad thread count" 2 "use a count" - -- "$bin" "$h" "$f" --threads 0
+expect_error "bad collapse floor" 2 "use a modulus" - -- "$bin" "$h" "$f" --collapse-floor -1
 expect_error "pose without calibration" 2 "needs calibrated" "$tmp/bad.png" -- \
   "$bin" "$h" "$f" --no-calibrate --jaw 50 --pose "$tmp/bad.png"
 expect_error "AFM without calibration" 2 "needs calibrated" "$tmp/bad.afm" -- \
