@@ -574,6 +574,43 @@ TEST(Physics, TheCollapseFloorKeepsEverySlabUpright) {
   }
 }
 
+// The same at the full range: with the floor, every muscle at -100 % and
+// +100 % of its calibrated range, and the jaw wide open, turn no slab on the
+// 1k head (without it 56 slabs turn over these poses).
+TEST(Physics, WithTheCollapseFloorNoSlabTurnsAtTheFullRange) {
+  FaceModelOptions fo;
+  fo.tissue.collapse_modulus = 0.3;
+  std::unique_ptr<Built> floored = afmtest::build_reference_model(1000, fo);
+  ASSERT_TRUE(floored);
+  const FaceModel &m = floored->model;
+  ASSERT_EQ(m.muscles.size(), 29u);
+  std::vector<Activation> poses;
+  for (size_t i = 0; i < m.muscles.size(); ++i)
+    for (double pct : {-100.0, 100.0}) {
+      Activation a;
+      a.muscles = {{static_cast<int>(i), pct}};
+      poses.push_back(a);
+    }
+  Activation jaw;
+  jaw.jaw_open = 100;
+  poses.push_back(jaw);
+  size_t turned = 0;
+  for (const Activation &a : poses) {
+    FactorCache cache;
+    Expected<Pose> p = solve_pose(m, a, &cache);
+    const std::string what = a.muscles.empty() ? std::string("the jaw")
+                                               : m.muscles[static_cast<size_t>(a.muscles[0].first)].name + " at " +
+                                                     std::to_string(static_cast<int>(a.muscles[0].second)) + " %";
+    ASSERT_TRUE(p.is_ok()) << what << ": " << p.status().message();
+    const size_t t = turned_slabs(m.tissue, p->X).size();
+    EXPECT_EQ(t, 0u) << what;
+    EXPECT_TRUE(p->X.allFinite()) << what;
+    EXPECT_EQ(penetrating_nodes(m.tissue, p->X, 1e-9), 0) << what;
+    turned += t;
+  }
+  std::printf("with the floor, %zu poses at the full range: %zu slabs turned\n", poses.size(), turned);
+}
+
 TEST(Physics, TheLidsSlideOverTheEyeball) {
   const FaceModel &m = head_1k().model;
   const refhead::HeadDesign &design = refhead::head_design();
