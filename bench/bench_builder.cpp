@@ -117,7 +117,8 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
 
   // Time to equilibrium at +100 % from rest, on V_d, factorisations included;
   // and the slabs of tissue the pose turns through themselves (skin_model.h,
-  // turned_slabs), which the tissue does not yet prevent (docs/notes.md).
+  // turned_slabs), which the default tissue does not prevent (the collapse
+  // floor, weighed at the end, does).
   std::printf("%-24s %6s %8s %6s %6s %6s %7s\n", "muscle (+100 %)", "V_d", "seconds", "iters", "CG", "fact",
               "turned");
   double sum = 0;

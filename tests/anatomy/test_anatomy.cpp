@@ -542,10 +542,6 @@ TEST(Physics, MusclesAlongTheBoneMoveTheSkinAlongItsSurface) {
   }
 }
 
-// The lids ride over the eyeballs (skin_model.h): spheres fitted to the eye
-// parts, which the generator made as spheres of known centre and radius.
-// Closing the eye hard presses the upper lid onto its eyeball; without the
-// contact the same pull takes the lid into it.
 // The collapse floor (TissueParams::collapse_modulus, solver.h): at a
 // tension that moves the brow or the upper lip about 10 mm on the 1k head,
 // the tissue alone turns slabs through themselves near the insertion; with
@@ -611,6 +607,10 @@ TEST(Physics, WithTheCollapseFloorNoSlabTurnsAtTheFullRange) {
   std::printf("with the floor, %zu poses at the full range: %zu slabs turned\n", poses.size(), turned);
 }
 
+// The lids ride over the eyeballs (skin_model.h): spheres fitted to the eye
+// parts, which the generator made as spheres of known centre and radius.
+// Closing the eye hard presses the upper lid onto its eyeball; without the
+// contact the same pull takes the lid into it.
 TEST(Physics, TheLidsSlideOverTheEyeball) {
   const FaceModel &m = head_1k().model;
   const refhead::HeadDesign &design = refhead::head_design();
