@@ -22,16 +22,6 @@ using Ldlt = BlockLdlt;
 // of the volume term: seen edge-on from the centre, their volume says nothing.
 constexpr double kVolumeFloor = 1e-3;
 
-// The full tangent takes the volume term's own curvature k_v (V - V0) / |V0|
-// d2V/dp2 only where an element's volume has changed by more than this share
-// of its rest volume. Below it the term is small next to the Gauss-Newton part
-// and the shape term, and the 27 x 27 volume Hessian of every element was a
-// tenth of the time (perf, Song's AFM). Measured (thirtieth session, afm-build
-// on two workers): Song's AFM byte-identical in 8 % less CPU; the 2k and 10k
-// heads' targets the same within a quantum but for a few whose path changes
-// (the 10k head's lower lid, negative, where it has two equilibria: 212 quanta).
-constexpr double kCurvatureShare = 0.01;
-
 // A 3x3 block of the Hessian inside the CSC value array: entry (r, c) is at
 // base + c * stride + r. base < 0: the block is not stored (a fixed node).
 struct Block {
@@ -281,8 +271,7 @@ void linearise(const System &sys, const Eigen::MatrixXd &X, SpMat &K, Vec &diag,
     double excess = 0;  // k_v (V - V0) / |V0|: the weight of the volume's own curvature
     if (el.weight > 0) {
       const double v = element_volume(m, X, el.f, &g);
-      if (full && std::abs(v - m.rest_volume[el.f]) > kCurvatureShare * std::abs(m.rest_volume[el.f]))
-        excess = el.weight * (v - m.rest_volume[el.f]);
+      if (full) excess = el.weight * (v - m.rest_volume[el.f]);
       if (excess != 0) element_volume_hessian(m, X, el.f, &H);
     }
     // Squeezed slabs: the floor's Gauss-Newton part w psi''(J) / V0^2 grad

@@ -26,11 +26,9 @@
 //             the element's nominal volume. Its tangent is the Gauss-Newton
 //             part k_c V_nom,s psi''(J) / V_s0^2 dV_s/dp dV_s/dp^T only,
 //             in both forms;
-//             The tangent above is the full one (the volume's second-order
-//             part only on elements whose volume changed by more than 1 %).
-//             Its "projected" form drops the compressed springs' negative
-//             T / l and the volume's second-order part, and is positive
-//             semi-definite everywhere.
+//             The tangent above is the full one. Its "projected" form drops
+//             the compressed springs' negative T / l and the volume's
+//             second-order part, and is positive semi-definite everywhere.
 //             The solvers use the full tangent where it is definite and the
 //             projected one where it is not (implicit-euler: always the
 //             projected one); the newton solvers, after two projected
