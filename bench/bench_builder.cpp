@@ -179,20 +179,23 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
     return false;
   }
   // One muscle's set at its calibrated +100 % tension, from rest, on the
-  // default (0) and the stiff (1) tissue.
-  auto solve_both = [&](const Muscle &mu, SolverKind kind, SolveStats st[2]) {
+  // default tissue (0) and on `other`'s (1); the poses into X when given.
+  auto solve_pair = [&](const FaceModel &other, const Muscle &mu, SolverKind kind, SolveStats st[2],
+                        Eigen::MatrixXd *X = nullptr) {
     for (int s = 0; s < 2; ++s) {
-      const FaceModel &fm = s == 0 ? *m : *ms;
-      ForceField f = [&](const Eigen::MatrixXd &X, Eigen::MatrixXd *F, NodeBlocks *K) {
-        return muscle_load(fm.tissue, mu, mu.tension_max, X, F, K);
+      const FaceModel &fm = s == 0 ? *m : other;
+      ForceField f = [&](const Eigen::MatrixXd &P, Eigen::MatrixXd *F, NodeBlocks *K) {
+        return muscle_load(fm.tissue, mu, mu.tension_max, P, F, K);
       };
-      Eigen::MatrixXd X = fm.tissue.X0;
+      Eigen::MatrixXd pose = fm.tissue.X0;
       SolverOptions so = m->solver;
       so.kind = kind;
       FactorCache cache;
-      st[s] = solve_equilibrium(fm.tissue, mu.dynamic, f, fm.tissue.X0, X, so, &cache);
+      st[s] = solve_equilibrium(fm.tissue, mu.dynamic, f, fm.tissue.X0, pose, so, &cache);
+      if (X) X[s] = std::move(pose);
     }
   };
+  auto solve_both = [&](const Muscle &mu, SolverKind kind, SolveStats st[2]) { solve_pair(*ms, mu, kind, st); };
   // Percent changes from a to b, and of CG iterations per step.
   auto change = [](double a, double b) { return 100.0 * (b - a) / std::max(1e-9, a); };
   auto per_step = [](int cg, int iterations) { return static_cast<double>(cg) / std::max(1, iterations); };
@@ -237,19 +240,16 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
   }
   int floor_its[2] = {0, 0}, floor_failed = 0;
   size_t floor_turned[2] = {0, 0};
-  for (const Muscle &mu : m->muscles)
+  for (const Muscle &mu : m->muscles) {
+    SolveStats st[2];
+    Eigen::MatrixXd X[2];
+    solve_pair(*mf, mu, m->solver.kind, st, X);
     for (int s = 0; s < 2; ++s) {
-      const FaceModel &fm = s == 0 ? *m : *mf;
-      ForceField f = [&](const Eigen::MatrixXd &X, Eigen::MatrixXd *F, NodeBlocks *K) {
-        return muscle_load(fm.tissue, mu, mu.tension_max, X, F, K);
-      };
-      Eigen::MatrixXd X = fm.tissue.X0;
-      FactorCache cache;
-      const SolveStats st = solve_equilibrium(fm.tissue, mu.dynamic, f, fm.tissue.X0, X, m->solver, &cache);
-      floor_its[s] += st.iterations;
-      floor_failed += !st.converged;
-      floor_turned[s] += turned_slabs(fm.tissue, X).size();
+      floor_its[s] += st[s].iterations;
+      floor_failed += !st[s].converged;
+      floor_turned[s] += turned_slabs((s == 0 ? *m : *mf).tissue, X[s]).size();
     }
+  }
   std::printf("collapse floor %.1f, every muscle at +100 %%: slabs turned %zu -> %zu, iterations %d -> %d (%+.0f %%)%s\n",
               kBenchFloor, floor_turned[0], floor_turned[1], floor_its[0], floor_its[1],
               change(floor_its[0], floor_its[1]),

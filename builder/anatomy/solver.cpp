@@ -52,6 +52,11 @@ FloorValue collapse_floor(double J, double j0) {
   return {u * u * u, -3 * u * u / j0, 6 * u / (j0 * j0)};
 }
 
+// The floor of slab `sl` of element `el` at X.
+FloorValue slab_floor(const SkinModel &m, const Eigen::MatrixXd &X, const Element &el, int sl) {
+  return collapse_floor(element_volume(m, X, el.f, nullptr, sl) / el.slab_rest[sl], m.params.collapse_knee);
+}
+
 // The unknowns of one dynamic set and the fixed sparsity of their Hessian:
 // 3x3 blocks between nodes joined by a spring or sharing an element. Built
 // once per set; every linearisation writes values into the same pattern.
@@ -284,7 +289,7 @@ void linearise(const System &sys, const Eigen::MatrixXd &X, SpMat &K, Vec &diag,
     for (int sl = 0; sl < 3; ++sl) {
       if (el.collapse[sl] <= 0) continue;
       const double v0 = el.slab_rest[sl];
-      const FloorValue p = collapse_floor(element_volume(m, X, el.f, nullptr, sl) / v0, m.params.collapse_knee);
+      const FloorValue p = slab_floor(m, X, el, sl);
       if (p.d2 <= 0) continue;
       element_volume(m, X, el.f, &gs[squeezed], sl);
       gauss[squeezed++] = el.collapse[sl] * p.d2 / (v0 * v0);
@@ -359,7 +364,7 @@ void net_force(const System &sys, const ForceField &forces, const Eigen::MatrixX
     for (int sl = 0; sl < 3; ++sl) {
       if (el.collapse[sl] <= 0) continue;
       const double v0 = el.slab_rest[sl];
-      const FloorValue p = collapse_floor(element_volume(m, X, el.f, nullptr, sl) / v0, m.params.collapse_knee);
+      const FloorValue p = slab_floor(m, X, el, sl);
       if (p.d1 == 0) continue;
       element_volume(m, X, el.f, &g, sl);
       const double c = -el.collapse[sl] * p.d1 / v0;
@@ -397,9 +402,7 @@ double total_energy(const System &sys, const ForceField &forces, const Eigen::Ma
       e += 0.5 * el.weight * dv * dv;
     }
     for (int sl = 0; sl < 3; ++sl)
-      if (el.collapse[sl] > 0)
-        e += el.collapse[sl] * collapse_floor(element_volume(m, X, el.f, nullptr, sl) / el.slab_rest[sl],
-                                              m.params.collapse_knee).e;
+      if (el.collapse[sl] > 0) e += el.collapse[sl] * slab_floor(m, X, el, sl).e;
     if (el.shape > 0) {
       Eigen::Matrix<double, 12, 3> d;
       for (int k = 0; k < 12; ++k) d.row(k) = X.row(el.global[k]) - ref.row(el.global[k]);
