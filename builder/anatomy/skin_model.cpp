@@ -346,44 +346,38 @@ double element_volume(const SkinModel &m, const Eigen::MatrixXd &X, int f, Eigen
   return v;
 }
 
-void element_volume_hessian(const SkinModel &m, const Eigen::MatrixXd &X, int f, Eigen::Matrix<double, 27, 27> *H) {
-  H->setZero();
-  auto skew = [](const Eigen::Vector3d &v) {
-    Eigen::Matrix3d s;
-    s << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
-    return s;
-  };
+Eigen::Matrix3d VolumeHessian::block(int i, int j) const {
+  if (i == j) return Eigen::Matrix3d::Zero();
+  const Eigen::Vector3d w = i < j ? upper[pair(i, j)] : Eigen::Vector3d(-upper[pair(j, i)]);
+  Eigen::Matrix3d s;
+  s << 0, -w.z(), w.y(), w.z(), 0, -w.x(), -w.y(), w.x(), 0;
+  return s;
+}
+
+void element_volume_hessian(const SkinModel &m, const Eigen::MatrixXd &X, int f, VolumeHessian *H) {
+  for (Eigen::Vector3d &w : H->upper) w.setZero();
   for (int slab = 0; slab < 3; ++slab) {
     int node[6], row[6];
     slab_corners(m, f, slab, node, row);
     for (const auto &t : kTets) {
-      // V = a . (b x c) / 6 with a, b, c = p1 - p0, p2 - p0, p3 - p0: its
-      // second derivatives in (a, b, c) are skew blocks, zero on the diagonal.
+      // V = a . (b x c) / 6 with a, b, c = p1 - p0, p2 - p0, p3 - p0: the
+      // mixed derivatives in (a, b), (a, c), (b, c) are the cross-product
+      // matrices of -c / 6, b / 6, -a / 6, and p0, which moves all three
+      // edges the other way, gets minus their sums.
       const Eigen::Vector3d p0 = X.row(node[t[0]]);
-      const Eigen::Vector3d e[3] = {X.row(node[t[1]]).transpose() - p0, X.row(node[t[2]]).transpose() - p0,
-                                    X.row(node[t[3]]).transpose() - p0};
-      Eigen::Matrix3d h[3][3];
-      h[0][0] = h[1][1] = h[2][2] = Eigen::Matrix3d::Zero();
-      h[0][1] = -skew(e[2]) / 6, h[0][2] = skew(e[1]) / 6, h[1][2] = -skew(e[0]) / 6;
-      h[1][0] = h[0][1].transpose(), h[2][0] = h[0][2].transpose(), h[2][1] = h[1][2].transpose();
-      // Points: p_{k+1} moves edge k; p0 moves all three edges the other way,
-      // so p0's blocks are minus the sums over an edge index.
-      Eigen::Matrix3d b[4][4];
-      b[0][0].setZero();
-      for (int a = 0; a < 3; ++a) {
-        b[a + 1][0].setZero();
-        b[0][a + 1].setZero();
-        for (int c = 0; c < 3; ++c) {
-          b[a + 1][c + 1] = h[a][c];
-          b[a + 1][0] -= h[a][c];
-          b[0][a + 1] -= h[c][a];
-          b[0][0] += h[a][c];
-        }
-      }
+      const Eigen::Vector3d a = X.row(node[t[1]]).transpose() - p0, b = X.row(node[t[2]]).transpose() - p0,
+                            c = X.row(node[t[3]]).transpose() - p0;
+      Eigen::Vector3d w[4][4];  // w[i][j] for the tet's points i < j
+      w[1][2] = -c / 6, w[1][3] = b / 6, w[2][3] = -a / 6;
+      w[0][1] = w[1][2] + w[1][3], w[0][2] = w[2][3] - w[1][2], w[0][3] = -w[1][3] - w[2][3];
       for (int i = 0; i < 4; ++i)
-        for (int j = 0; j < 4; ++j) {
+        for (int j = i + 1; j < 4; ++j) {
           const int ri = row[t[i]], rj = row[t[j]];
-          if (ri >= 0 && rj >= 0) H->block<3, 3>(3 * ri, 3 * rj) += b[i][j];
+          if (ri < 0 || rj < 0) continue;
+          if (ri < rj)
+            H->upper[VolumeHessian::pair(ri, rj)] += w[i][j];
+          else
+            H->upper[VolumeHessian::pair(rj, ri)] -= w[i][j];
         }
     }
   }

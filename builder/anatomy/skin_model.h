@@ -202,10 +202,18 @@ int nearest_node(const SkinModel &m, int layer, const Eigen::Vector3d &p);
 double element_volume(const SkinModel &m, const Eigen::MatrixXd &X, int f,
                       Eigen::Matrix<double, 9, 3> *gradient = nullptr, int slab = -1);
 
-// The Hessian of element_volume(): 27 x 27, the 3 x 3 block (i, j) for the
-// gradient rows i and j (layers 0..2). Indefinite (the volume is cubic in
-// the positions).
-void element_volume_hessian(const SkinModel &m, const Eigen::MatrixXd &X, int f, Eigen::Matrix<double, 27, 27> *H);
+// The Hessian of element_volume() (27 x 27, indefinite: the volume is cubic
+// in the positions). Each 3 x 3 block is a cross-product matrix, so it is kept
+// as one vector per pair of gradient rows (layers 0..2): block (i, j) applied
+// to a vector x is w(i, j) x x, with w(j, i) = -w(i, j) and zero blocks on the
+// diagonal. A ninth of the dense matrix's numbers.
+struct VolumeHessian {
+  Eigen::Vector3d upper[36];  // w(i, j) for i < j, row by row: (0,1) .. (0,8), (1,2) ..
+  static int pair(int i, int j) { return i * (17 - i) / 2 + j - i - 1; }  // i < j
+  // The block's cross-product matrix, any i and j in 0..8.
+  Eigen::Matrix3d block(int i, int j) const;
+};
+void element_volume_hessian(const SkinModel &m, const Eigen::MatrixXd &X, int f, VolumeHessian *H);
 
 // Per-tetrahedron signed volumes of element f: 9 values. An element is
 // inverted when one of its tetrahedra changed sign from the rest state.

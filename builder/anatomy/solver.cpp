@@ -270,7 +270,7 @@ void linearise(const System &sys, const Eigen::MatrixXd &X, SpMat &K, Vec &diag,
     if (bl[2].base >= 0) add_block(val, bl[2], -B), add_block(val, bl[3], -B);
   }
   Eigen::Matrix<double, 9, 3> g, gs[3];
-  Eigen::Matrix<double, 27, 27> H;
+  VolumeHessian H;
   for (size_t e = 0; e < sys.elements.size(); ++e) {
     const Element &el = sys.elements[e];
     double excess = 0;  // k_v (V - V0) / |V0|: the weight of the volume's own curvature
@@ -301,7 +301,7 @@ void linearise(const System &sys, const Eigen::MatrixXd &X, SpMat &K, Vec &diag,
         Eigen::Matrix3d B = Eigen::Matrix3d::Identity() * (el.shape * ((i == j ? 1.0 : 0.0) - 1.0 / 12.0));
         if (el.weight > 0) B.noalias() += el.weight * g.row(i).transpose() * g.row(j);
         for (int q = 0; q < squeezed; ++q) B.noalias() += gauss[q] * gs[q].row(i).transpose() * gs[q].row(j);
-        if (excess != 0) B += excess * H.block<3, 3>(3 * i, 3 * j);
+        if (excess != 0 && i != j) B += excess * H.block(i, j);
         add_block(val, b, B);
       }
   }
