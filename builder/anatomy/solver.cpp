@@ -294,8 +294,10 @@ void linearise(const System &sys, const Eigen::MatrixXd &X, SpMat &K, Vec &diag,
       element_volume(m, X, el.f, &gs[squeezed], sl);
       gauss[squeezed++] = el.collapse[sl] * p.d2 / (v0 * v0);
     }
+    // Block (j, i) is written as the transpose of block (i, j), so that K is
+    // symmetric to the last bit (and half the blocks are made).
     for (int i = 0; i < 9; ++i)
-      for (int j = 0; j < 9; ++j) {
+      for (int j = i; j < 9; ++j) {
         const Block b = sys.element_blocks[81 * e + static_cast<size_t>(9 * i + j)];
         if (b.base < 0) continue;
         Eigen::Matrix3d B = Eigen::Matrix3d::Identity() * (el.shape * ((i == j ? 1.0 : 0.0) - 1.0 / 12.0));
@@ -303,6 +305,7 @@ void linearise(const System &sys, const Eigen::MatrixXd &X, SpMat &K, Vec &diag,
         for (int q = 0; q < squeezed; ++q) B.noalias() += gauss[q] * gs[q].row(i).transpose() * gs[q].row(j);
         if (excess != 0 && i != j) B += excess * H.block(i, j);
         add_block(val, b, B);
+        if (j != i) add_block(val, sys.element_blocks[81 * e + static_cast<size_t>(9 * j + i)], B.transpose());
       }
   }
   diag.resize(sys.dofs());
