@@ -38,7 +38,7 @@ constexpr double kBenchFloor = 0.3;
 double off_median(const FapSynthesis &f) {
   std::vector<double> off;
   for (const FapOutcome &o : f.outcomes)
-    if (o.made && o.kind == AFM_TARGET_FAP) off.push_back(o.off_axis);
+    if (solved_fap_target(o)) off.push_back(o.off_axis);
   std::sort(off.begin(), off.end());
   return off.empty() ? 0.0 : 100 * off[off.size() / 2];
 }

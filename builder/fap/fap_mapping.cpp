@@ -95,7 +95,15 @@ std::vector<FapMapping> make_table() {
   add(41, D::Muscles, 120, {{"zygomaticus_major_left", 100}, {"zygomaticus_minor_left", 100}}, {}, "");
   add(42, D::Muscles, 120, {{"zygomaticus_major_right", 100}, {"zygomaticus_minor_right", 100}}, {}, "");
   // ---- group 6: tongue ----
-  for (int f = 43; f <= 47; ++f) add(f, D::None, 0, {}, {}, "the tongue is not simulated yet");
+  // No stream in ../shared/data sends them: references from the mouth's
+  // size, about a centimetre on an adult face (MW0 about 5 cm, MNS0 about
+  // 2 cm), and a 30-degree roll.
+  const char *tongue = "the tongue part's own motion, exact at its FDP: anatomy/tongue.h";
+  add(43, D::Tongue, 200, {}, {}, tongue);
+  add(44, D::Tongue, 512, {}, {}, tongue);
+  add(45, D::Tongue, 200, {}, {}, tongue);
+  add(46, D::Tongue, 512, {}, {}, tongue);
+  add(47, D::Tongue, 52360, {}, {}, tongue);
   // ---- group 7: head ----
   for (int f = 48; f <= 50; ++f) add(f, D::Rigid, 0, {}, {}, rigid_head);
   // ---- group 9: nose ----
@@ -155,12 +163,14 @@ std::vector<HighLevelMapping> make_high_level_table() {
     const char *muscle;  // a pair name (both sides) or a single muscle's
     double percent;
   };
-  auto add = [&](bool expression, int number, int jaw, std::vector<Pair> pairs, const char *note) {
+  auto add = [&](bool expression, int number, int jaw, std::vector<Pair> pairs, const char *note,
+                 std::vector<std::pair<int, int>> tongue = {}) {
     HighLevelMapping m;
     m.expression = expression;
     m.number = number;
     m.jaw_open = jaw;
     m.note = note;
+    m.tongue = std::move(tongue);
     for (const Pair &p : pairs) {
       const std::string name = p.muscle;
       if (name == "orbicularis_oris") m.muscles.push_back({name, p.percent});
@@ -170,20 +180,30 @@ std::vector<HighLevelMapping> make_high_level_table() {
     t.push_back(std::move(m));
   };
   // ---- visemes (ISO/IEC 14496-2 Table C-1) ----
+  // The tongue (FAPs 43-47; references 200 MW and 512 MNS units, about a
+  // centimetre): the tip forward between the teeth for the dental /T, D/,
+  // up to the ridge behind the upper teeth for /t, d/, /n, l/ and the
+  // sibilants, curled back for /r/, the body up to the soft palate for /k, g/,
+  // high for the front vowels, low for the open ones.
   add(false, 1, 0, {{"orbicularis_oris", 50}, {"mentalis", 40}}, "lips pressed together");
   add(false, 2, 60, {{"mentalis", 60}, {"upper_lip", -30}}, "lower lip up against the upper teeth");
-  add(false, 3, 100, {}, "jaw a little open, tongue between the teeth");
-  add(false, 4, 90, {}, "jaw a little open");
-  add(false, 5, 130, {}, "jaw half open");
-  add(false, 6, 80, {{"orbicularis_oris", 60}, {"upper_lip", -20}}, "lips rounded and pushed out");
-  add(false, 7, 50, {{"risorius", 50}}, "teeth near, lips spread");
-  add(false, 8, 100, {}, "jaw a little open");
-  add(false, 9, 90, {{"orbicularis_oris", 40}}, "lips a little rounded");
-  add(false, 10, 300, {}, "jaw wide open");
-  add(false, 11, 180, {{"risorius", 50}, {"zygomaticus_major", 20}}, "jaw open, lips spread");
-  add(false, 12, 100, {{"risorius", 70}, {"zygomaticus_major", 30}}, "lips spread wide");
-  add(false, 13, 250, {{"orbicularis_oris", 40}}, "jaw open, lips rounded");
-  add(false, 14, 90, {{"orbicularis_oris", 90}}, "lips tightly rounded and pushed out");
+  add(false, 3, 100, {}, "jaw a little open, tongue between the teeth", {{45, 150}, {44, 100}});
+  add(false, 4, 90, {}, "jaw a little open, tongue tip up to the ridge", {{44, 400}, {45, 50}});
+  add(false, 5, 130, {}, "jaw half open, tongue body up to the soft palate", {{46, 450}});
+  add(false, 6, 80, {{"orbicularis_oris", 60}, {"upper_lip", -20}}, "lips rounded and pushed out, tongue blade up",
+      {{44, 300}, {46, 200}});
+  add(false, 7, 50, {{"risorius", 50}}, "teeth near, lips spread, tongue tip up", {{44, 300}});
+  add(false, 8, 100, {}, "jaw a little open, tongue tip up to the ridge", {{44, 400}});
+  add(false, 9, 90, {{"orbicularis_oris", 40}}, "lips a little rounded, tongue tip up and back",
+      {{44, 250}, {45, -100}});
+  add(false, 10, 300, {}, "jaw wide open, tongue low", {{46, -200}});
+  add(false, 11, 180, {{"risorius", 50}, {"zygomaticus_major", 20}}, "jaw open, lips spread, tongue half high",
+      {{46, 150}});
+  add(false, 12, 100, {{"risorius", 70}, {"zygomaticus_major", 30}}, "lips spread wide, tongue high",
+      {{46, 250}});
+  add(false, 13, 250, {{"orbicularis_oris", 40}}, "jaw open, lips rounded, tongue low", {{46, -150}});
+  add(false, 14, 90, {{"orbicularis_oris", 90}}, "lips tightly rounded and pushed out, tongue back up",
+      {{46, 200}});
   // ---- expressions (ISO/IEC 14496-2 Table C-3) ----
   add(true, 1, 40,
       {{"zygomaticus_major", 100}, {"zygomaticus_minor", 50}, {"risorius", 20}, {"orbicularis_oculi", 40}},
@@ -236,6 +256,7 @@ const char *fap_driver_name(FapDriver driver) {
     case FapDriver::JawOpen: return "jaw-open";
     case FapDriver::JawThrust: return "jaw-thrust";
     case FapDriver::JawShift: return "jaw-shift";
+    case FapDriver::Tongue: return "tongue";
     case FapDriver::Rigid: return "rigid";
     case FapDriver::None: return "none";
   }
@@ -273,6 +294,9 @@ std::string fap_mapping_text() {
     out += head;
     if (m.jaw_open) out += "  jaw " + std::to_string(m.jaw_open);
     if (!m.muscles.empty()) out += "  + " + group(m.muscles);
+    for (size_t k = 0; k < m.tongue.size(); ++k)
+      out += (k ? ", " : "  tongue ") + std::to_string(m.tongue[k].first) + " " +
+             (m.tongue[k].second > 0 ? "+" : "") + std::to_string(m.tongue[k].second);
     out += std::string("  (") + m.note + ")\n";
   }
   return out;

@@ -16,6 +16,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace afmb {
@@ -25,6 +26,7 @@ enum class FapDriver {
   JawOpen,    // the jaw's rotation: a morph target and the jaw's rigid control
   JawThrust,  // the jaw's forward translation: likewise
   JawShift,   // the jaw's sideways translation: likewise
+  Tongue,     // the tongue part's kinematic motion (anatomy/tongue.h): a morph target
   Rigid,      // eyeballs and head: a rigid part's control in the AFM, no target
   None,       // not synthesized; `note` says why
 };
@@ -74,7 +76,7 @@ const std::vector<FapMapping> &fap_mappings();
 // The mapping of FAP `fap`, or nullptr when fap is not in 3..68.
 const FapMapping *find_fap_mapping(int fap);
 
-// "muscles", "jaw-open", "jaw-thrust", "jaw-shift", "rigid", "none".
+// "muscles", "jaw-open", "jaw-thrust", "jaw-shift", "tongue", "rigid", "none".
 const char *fap_driver_name(FapDriver driver);
 
 // The 14 visemes and 6 expressions (FAP 1 and 2): each a fixed muscle
@@ -87,6 +89,10 @@ struct HighLevelMapping {
   int number = 0;                           // viseme 1..14, expression 1..6
   std::vector<FapContraction> muscles;      // percent of each muscle's calibrated range
   int jaw_open = 0;                         // FAP 3 (open_jaw) units, MNS/1024: how far the chin drops
+  // The tongue's FAPs (43-47) and their values, FAP units: its motion
+  // (anatomy/tongue.h) in the target, under the jaw's, where the face has a
+  // tongue.
+  std::vector<std::pair<int, int>> tongue;
   const char *note = "";                    // what the face does
 };
 

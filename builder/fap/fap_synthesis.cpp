@@ -12,6 +12,7 @@
 
 #include "afm/rigid_parts.h"
 #include "anatomy/skin_binding.h"
+#include "anatomy/tongue.h"
 #include "core/fapu.h"
 #include "core/parallel.h"
 #include "core/part_kind.h"
@@ -240,6 +241,10 @@ CalibrationNeeds calibration_needs(const FapSynthesisOptions &options) {
   return need;
 }
 
+bool solved_fap_target(const FapOutcome &o) {
+  return o.made && o.kind == AFM_TARGET_FAP && !is_tongue_fap(o.number);
+}
+
 Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &model, const FapSynthesisOptions &options) {
   if (model.skin < 0 || model.tissue.n == 0) return Status::error("FAP synthesis: the model has no skin");
   const SkinModel &skin = model.tissue;
@@ -269,7 +274,9 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     if (!everything && !listed(options.only, m.fap)) continue;
     work.push_back({&m, nullptr, +1, m.reference});
     for (int r : m.farther) work.push_back({&m, nullptr, +1, r, true});
-    if (options.negative_sides && !m.negative.empty()) work.push_back({&m, nullptr, -1, m.reference});
+    const bool own_negative =
+        !m.negative.empty() || (m.driver == FapDriver::Tongue && tongue_negative_target(m.fap));
+    if (options.negative_sides && own_negative) work.push_back({&m, nullptr, -1, m.reference});
   }
   for (const HighLevelMapping &h : high_level_mappings())
     if (everything || listed(h.expression ? options.only_expressions : options.only_visemes, h.number))
@@ -298,6 +305,9 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     std::optional<RigidPart::Control> control, glide;
   };
   std::vector<Result> results(work.size());
+  // The tongue (anatomy/tongue.h), where the face has one with FDPs
+  // 6.1-6.4: the tongue FAPs' own motion, exact at the FDP, and the visemes'.
+  const Expected<Tongue> tongue = find_tongue(scene, model.fdps);
   // A viseme or an expression: the table's pose, once.
   auto make_high_level = [&](const HighLevelMapping &h, Result &res) {
     const auto start = std::chrono::steady_clock::now();
@@ -316,6 +326,8 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         a.muscles.push_back({i, c.percent});
     }
     if (!missing.empty()) o.message = "without " + missing + ": not in the model or not calibrated";
+    if (!h.tongue.empty() && !tongue)
+      o.message += std::string(o.message.empty() ? "" : "; ") + "without the tongue: " + tongue.status().message();
     Eigen::Affine3d jaw = Eigen::Affine3d::Identity();
     if (h.jaw_open > 0) {
       // The chin (2.1) drops by jaw_open FAP 3 units, as the bone carries it.
@@ -422,11 +434,19 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         t.displacement[static_cast<size_t>(model.skin)] = D;
         carry(D, t);
         // No rigid control serves FAP 1 or 2: the jaw's parts move in the
-        // target itself.
+        // target itself, the tongue in its own shape first.
+        Eigen::MatrixXd shaped;  // the tongue's displacement before the jaw's
+        if (!h.tongue.empty() && tongue) {
+          const Eigen::MatrixXd &V = scene.parts[static_cast<size_t>(tongue->part)].V;
+          shaped = Eigen::MatrixXd::Zero(V.rows(), 3);
+          for (const auto &[fap, value] : h.tongue) shaped += tongue_displacement(*tongue, V, model.fapu, fap, value);
+          t.displacement[static_cast<size_t>(tongue->part)] = shaped;
+        }
         if (!jaw.matrix().isIdentity(0))
           for (int p : out.jaw.parts) {
             const Eigen::MatrixXd &V = scene.parts[static_cast<size_t>(p)].V;
-            t.displacement[static_cast<size_t>(p)] = moved_points(jaw, V) - V;
+            const bool own = shaped.size() > 0 && p == tongue->part;
+            t.displacement[static_cast<size_t>(p)] = moved_points(jaw, own ? Eigen::MatrixXd(V + shaped) : V) - V;
           }
         res.target = std::move(t);
       }
@@ -434,9 +454,44 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     o.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     res.outcome = std::move(o);
   };
+  // A tongue FAP: its own motion (anatomy/tongue.h), no solve.
+  auto make_tongue = [&](const FapMapping &map, int side, int reference, Result &res) {
+    FapOutcome &o = res.outcome;
+    o.number = map.fap;
+    o.side = side;
+    o.reference = side * reference;
+    if (!tongue) {
+      o.message = tongue.status().message();
+      return;
+    }
+    const afm_fap_info *info = afm_fap(map.fap);
+    const double value = side * reference;
+    if (map.fap == 45 && !(value * fapu_distance(model.fapu, info->unit) / 1024.0 > -0.5 * tongue->length)) {
+      o.message = "the tongue would shorten by half or more";
+      return;
+    }
+    const FdpPoint *fdp = model.fdps.find(FdpId{info->fdp_group, info->fdp_index}, tongue->part);
+    const Eigen::MatrixXd &V = scene.parts[static_cast<size_t>(tongue->part)].V;
+    const Eigen::MatrixXd D = tongue_displacement(*tongue, V, model.fapu, map.fap, value);
+    o.prescribed = tongue_fdp_motion(*tongue, model.fapu, map.fap, value);
+    // The roll's FDP turns: measured along the chord MPEG-4's angle gives it.
+    const Eigen::Vector3d dir = map.fap == 47 ? o.prescribed.normalized() : Eigen::Vector3d(side * fap_direction(info));
+    measure(o, D.row(fdp->vertex).transpose(), dir);
+    o.largest = D.rowwise().norm().maxCoeff();
+    o.made = true;
+    MorphTarget t;
+    t.kind = AFM_TARGET_FAP;
+    t.number = map.fap;
+    t.reference = o.reference;
+    t.displacement.assign(scene.parts.size(), Eigen::MatrixXd());
+    t.displacement[static_cast<size_t>(tongue->part)] = D;
+    res.target = std::move(t);
+  };
   auto make = [&](size_t k) {
     Result &res = results[k];
     if (work[k].high) return make_high_level(*work[k].high, res);
+    if (work[k].fap->driver == FapDriver::Tongue)
+      return make_tongue(*work[k].fap, work[k].side, work[k].reference, res);
     const FapMapping *map = work[k].fap;
     const int side = work[k].side, reference = work[k].reference;
     const auto start = std::chrono::steady_clock::now();
@@ -826,7 +881,9 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
   for (int v = 0; v < skin.n; ++v) held[static_cast<size_t>(v)] = skin.eye_near[static_cast<size_t>(v)] >= 0;
   for (size_t k = 0; k < results.size(); ++k) {
     Result &r = results[k];
-    if (r.target) {
+    if (r.target && r.target->displacement[static_cast<size_t>(model.skin)].rows() == 0) {
+      out.targets.push_back(std::move(*r.target));  // the skin does not move (the tongue's)
+    } else if (r.target) {
       MorphTarget &t = *r.target;
       Eigen::MatrixXd &D = t.displacement[static_cast<size_t>(model.skin)];
       std::vector<char> fixed = held;

@@ -11,6 +11,11 @@
 // the pose of the largest motion solved so far not past its own); the jaw's rigid parts
 // (lower teeth, tongue) get a control with the same motion.
 //
+// The tongue's FAPs (43-47) are no solve: the tongue part's own motion
+// (anatomy/tongue.h), exact at its FDP, where the face has a tongue with
+// FDPs 6.1-6.4 (else not made, and the outcome says what is missing). The
+// visemes add theirs (HighLevelMapping::tongue) under the jaw's motion.
+//
 // In-betweens (FapMapping::farther; formats/afm.md): the same solve at each
 // farther reference, kept only where the group reaches it in full. The
 // player blends a side's targets piecewise linearly, so a lid follows its
@@ -127,6 +132,12 @@ struct FapOutcome {
   int dynamic = 0;                // vertices solved
   double seconds = 0;
 };
+
+// Whether a made outcome is a FAP target the face model solved (muscles,
+// jaw, lids): the ones the fidelity figures summarise. The tongue's
+// (anatomy/tongue.h) move their FDPs exactly by construction, and visemes
+// and expressions have no FDP rule.
+bool solved_fap_target(const FapOutcome &o);
 
 struct FapSynthesisOptions {
   // What to make. All three empty: every mapped FAP, viseme and expression;

@@ -18,7 +18,7 @@ if [ ! -f "$song/song.WRL" ] || [ ! -f "$stream" ]; then
 fi
 
 if [ "${AFM_CONFIG:-release}" = sanitize ]; then
-  subset="--faps 3,12,19,v10,e1" want=7
+  subset="--faps 3,12,19,43,47,v10,e1" want=9
 else
   subset="" want=90
 fi
@@ -30,6 +30,11 @@ grep -q "^note: on the .*simulation mesh:.*tried" "$tmp/build.txt" &&
 made=$(sed -n 's/^targets: \([0-9]*\) made.*/\1/p' "$tmp/build.txt")
 [ -n "$made" ] && [ "$made" -ge "$want" ] || fail "Song: ${made:-no} targets made, expected at least $want"
 grep -q "^e1  *joy  *63 " "$tmp/build.txt" || fail "Song: no joy target: $(grep -c . "$tmp/build.txt") lines"
+# Song has a tongue part with FDPs 6.1-6.4: its FAPs are made, exact at the FDP.
+for f in "43  *shift_tongue_tip" "47  *tongue_roll"; do
+  grep -q "^$f .* 0\.00% .*the tongue's own motion" "$tmp/build.txt" ||
+    fail "Song: no tongue target ($f): $(grep "^4[3-7] " "$tmp/build.txt")"
+done
 [ -s "$tmp/report/sheet.png" ] && [ -s "$tmp/report/index.html" ] || fail "Song: no fidelity report"
 
 "$bin/afm-play" "$tmp/song.afm" "$stream" >"$tmp/play.txt" 2>&1 || fail "afm-play failed on Song: $(tail -n 3 "$tmp/play.txt")"

@@ -27,6 +27,7 @@
 #include "fap/fap_mapping.h"
 #include "fap/fap_partition.h"
 #include "fap/fap_synthesis.h"
+#include "fap/fidelity_report.h"
 #include "fap/steer.h"
 #include "fap/untangle.h"
 #include "io/load_face.h"
@@ -60,6 +61,11 @@ TEST(FapMapping, CoversEveryLowLevelFapOnceAndAgreesWithTheMpeg4Table) {
     }
     if (m.driver == FapDriver::Muscles) {
       EXPECT_FALSE(m.positive.empty()) << m.fap;
+    }
+    // The tongue's group of the table, each with a reference.
+    EXPECT_EQ(m.driver == FapDriver::Tongue, info->group == 6) << m.fap;
+    if (m.driver == FapDriver::Tongue) {
+      EXPECT_GT(m.reference, 0) << m.fap;
     }
     if (!info->bidirectional) {
       EXPECT_TRUE(m.negative.empty()) << m.fap << " is unidirectional";
@@ -489,6 +495,44 @@ TEST(HighLevel, VisemeAOpensTheJawByItsTableValueAndCarriesTheTeeth) {
     EXPECT_NEAR((P.row(i) - P.row(0)).norm(), (V.row(i) - V.row(0)).norm(), 1e-9) << "rigid";
   // The upper face stays: the brows (4.1) do not move (within a quantum).
   EXPECT_LT(at_fdp(*t, 4, 1).norm(), m.quantum);
+}
+
+// The visemes move the tongue (fap_mapping.cpp) under the jaw's motion: for
+// the dental /T, D/ its tip comes forward past the lower incisors' edge
+// (9.11), between the teeth; for /k, g/ the body (6.2) rises to the soft
+// palate although the jaw, half open, drops it.
+TEST(HighLevel, TheVisemesPutTheTongueWherePhoneticsSays) {
+  const Built &b = head_1k();
+  FapSynthesisOptions o;
+  o.only_visemes = {3, 5};
+  Expected<FapSynthesis> s = synthesize_faps(b.head.scene, b.model, o);
+  ASSERT_TRUE(s.is_ok()) << s.status().message();
+  ASSERT_EQ(s->targets.size(), 2u);
+  const int tongue = b.head.scene.find_kind(PartKind::Tongue), teeth = b.head.scene.find_kind(PartKind::TeethLower);
+  ASSERT_TRUE(tongue >= 0 && teeth >= 0);
+  auto moved = [&](const MorphTarget &t, int part, int group, int index) {
+    const FdpPoint *p = b.head.fdps.find(FdpId{group, index}, part);
+    EXPECT_TRUE(p && p->part == part) << group << "." << index;
+    return Eigen::Vector3d(p->pos + t.displacement[static_cast<size_t>(part)].row(p->vertex).transpose());
+  };
+  const FdpPoint *tip = b.head.fdps.find(FdpId{6, 1}, tongue), *edge = b.head.fdps.find(FdpId{9, 11}, teeth);
+  ASSERT_TRUE(tip && edge);
+  ASSERT_LT(tip->pos.z(), edge->pos.z()) << "at rest the tip lies behind the lower incisors";
+  const MorphTarget &th = s->targets[0];
+  EXPECT_GT(moved(th, tongue, 6, 1).z(), moved(th, teeth, 9, 11).z()) << "/T, D/: the tip between the teeth";
+  const MorphTarget &kg = s->targets[1];
+  EXPECT_LT(moved(kg, teeth, 9, 11).y(), edge->pos.y()) << "the jaw opens";
+  EXPECT_GT(moved(kg, tongue, 6, 2).y(), b.head.fdps.find(FdpId{6, 2}, tongue)->pos.y()) << "/k, g/: the body rises";
+  // Without the tongue part the visemes are made and say so.
+  Scene none = b.head.scene;
+  for (Part &p : none.parts)
+    if (p.kind == PartKind::Tongue) p.kind = PartKind::Other;
+  o.only_visemes = {3};
+  Expected<FapSynthesis> n = synthesize_faps(none, b.model, o);
+  ASSERT_TRUE(n.is_ok()) << n.status().message();
+  ASSERT_EQ(n->outcomes.size(), 1u);
+  EXPECT_TRUE(n->outcomes[0].made);
+  EXPECT_NE(n->outcomes[0].message.find("without the tongue"), std::string::npos) << n->outcomes[0].message;
 }
 
 // Joy raises the left mouth corner (8.3) and draws it outward, as FAPs 59
@@ -1014,6 +1058,75 @@ TEST(FapSynthesis, AFapThatIsTheSameSolveAsAnotherCopiesItsTarget) {
   EXPECT_GT(both->outcomes[0].seconds, 0);
   EXPECT_EQ(both->outcomes[1].reference, 150);
   EXPECT_EQ(both->outcomes[1].achieved, alone->outcomes[0].achieved);
+}
+
+// The tongue's FAPs (anatomy/tongue.h) on a head that has one: each made,
+// moving the tongue alone and its FDP by reference x FAPU along the table's
+// direction, in the AFM too (to half a quantum); 45 with a negative side of
+// its own; and left out of the report's figures, which measure the muscles.
+TEST(FapSynthesis, TheTongueFapsMoveTheTongueAloneAndItsFdpByTheMpeg4Rule) {
+  const Built &b = head_1k();
+  FapSynthesisOptions o;
+  o.only = {43, 44, 45, 46, 47};
+  Expected<FapSynthesis> s = synthesize_faps(b.head.scene, b.model, o);
+  ASSERT_TRUE(s.is_ok()) << s.status().message();
+  ASSERT_EQ(s->outcomes.size(), 6u);
+  ASSERT_EQ(s->targets.size(), 6u);
+  const int tongue = b.head.scene.find_kind(PartKind::Tongue);
+  ASSERT_GE(tongue, 0);
+  const Eigen::MatrixXd &V = b.head.scene.parts[static_cast<size_t>(tongue)].V;
+  for (size_t k = 0; k < s->outcomes.size(); ++k) {
+    const FapOutcome &oc = s->outcomes[k];
+    const MorphTarget &t = s->targets[k];
+    SCOPED_TRACE("FAP " + std::to_string(oc.number) + " side " + std::to_string(oc.side));
+    ASSERT_TRUE(oc.made) << oc.message;
+    EXPECT_FALSE(solved_fap_target(oc));
+    EXPECT_EQ(oc.side < 0, oc.number == 45 && k == 3) << "only the thrust has its own negative side";
+    for (size_t p = 0; p < t.displacement.size(); ++p)
+      if (static_cast<int>(p) != tongue) {
+        EXPECT_TRUE(t.displacement[p].size() == 0 || t.displacement[p].isZero()) << "part " << p;
+      }
+    const Eigen::MatrixXd &D = t.displacement[static_cast<size_t>(tongue)];
+    ASSERT_EQ(D.rows(), V.rows());
+    const afm_fap_info *info = afm_fap(oc.number);
+    const FdpPoint *f = b.head.fdps.find(FdpId{info->fdp_group, info->fdp_index}, tongue);
+    ASSERT_TRUE(f && f->part == tongue);
+    const Eigen::Vector3d moved = D.row(f->vertex).transpose();
+    if (oc.number == 47) {
+      // Concave upward: both borders rise alike.
+      const FdpPoint *right = b.head.fdps.find(FdpId{6, 4}, tongue);
+      ASSERT_TRUE(right);
+      EXPECT_GT(moved.y(), 0);
+      EXPECT_NEAR(D(right->vertex, 1), moved.y(), 1e-9);
+    } else {
+      const Eigen::Vector3d want = t.reference * fapu_distance(b.model.fapu, info->unit) / 1024 * direction_of(oc.number);
+      EXPECT_LT((moved - want).norm(), 1e-12) << moved.transpose() << " against " << want.transpose();
+    }
+  }
+  EXPECT_NE(fidelity_table(*s).find("the tongue's 6 targets are exact by construction"), std::string::npos);
+
+  // Through the AFM: the stored deltas of the tongue are the builder's.
+  const AfmContent content = fap_afm_content(b.head.scene, b.head.fdps, b.model, *s);
+  const DocPtr hold = encoded_doc(content);
+  ASSERT_NE(hold.get(), nullptr);
+  const afm_doc *doc = hold.get();
+  ASSERT_EQ(doc->target_count, 6u);
+  const RenderVertices rv = afm_render_vertices(content);
+  std::vector<int32_t> q15(3 * size_t(afm_doc_entry_count(doc)));
+  for (uint32_t i = 0; i < doc->target_count; ++i) {
+    const afm_target &at = doc->targets[i];
+    const MorphTarget &t = s->targets[i];
+    ASSERT_EQ(int(at.number), t.number);
+    ASSERT_EQ(at.reference, t.reference);
+    ASSERT_EQ(afm_target_expand(doc, &at, q15.data()), AFM_OK);
+    const Eigen::MatrixXd &D = t.displacement[static_cast<size_t>(tongue)];
+    double worst = 0;
+    for (Eigen::Index w = 0; w < D.rows(); ++w)
+      for (uint32_t v : rv.copies[static_cast<size_t>(tongue)][size_t(w)])
+        for (int c = 0; c < 3; ++c)
+          worst = std::max(worst, std::abs(q15[3 * size_t(v) + size_t(c)] / 32768.0 - D(w, c) / doc->geometry.step));
+    EXPECT_LE(worst, 0.5 + 1e-6) << "FAP " << t.number;
+  }
 }
 
 // A target for the partition (fap_partition.h): FAP, FDP vertex, direction, muscles.
