@@ -76,8 +76,12 @@ std::vector<FapMapping> make_table() {
     t[k].farther = t[k].lid > 0 ? std::vector<int>{600, 1024} : std::vector<int>{600};
   }
   for (int f = 23; f <= 28; ++f) add(f, D::Rigid, 0, {}, {}, rigid_eye);
-  add(29, D::None, 0, {}, {}, "pupil dilation needs pupil geometry, which the eye parts do not have");
-  add(30, D::None, 0, {}, {}, "pupil dilation needs pupil geometry, which the eye parts do not have");
+  // Dilation where the eye part draws its pupil with vertices: the
+  // diameter grows by about a third of the iris' (the neutral pupil's own
+  // third to two thirds) at the reference.
+  const char *pupil = "the eye part's pupil ring widens, the iris narrows: anatomy/pupil.h";
+  add(29, D::Pupil, 300, {}, {}, pupil);
+  add(30, D::Pupil, 300, {}, {}, pupil);
   // ---- group 4: eyebrows ----
   add(31, D::Muscles, 200, {{"frontalis_inner_left", 100}}, {{"frontalis_inner_left", -100}}, "");
   add(32, D::Muscles, 200, {{"frontalis_inner_right", 100}}, {{"frontalis_inner_right", -100}}, "");
@@ -244,6 +248,11 @@ const std::vector<FapMapping> &fap_mappings() {
   return table;
 }
 
+bool kinematic_fap(int fap) {
+  const FapMapping *m = find_fap_mapping(fap);
+  return m && (m->driver == FapDriver::Tongue || m->driver == FapDriver::Pupil);
+}
+
 const FapMapping *find_fap_mapping(int fap) {
   const std::vector<FapMapping> &t = fap_mappings();
   if (fap < 3 || fap > 68) return nullptr;
@@ -257,6 +266,7 @@ const char *fap_driver_name(FapDriver driver) {
     case FapDriver::JawThrust: return "jaw-thrust";
     case FapDriver::JawShift: return "jaw-shift";
     case FapDriver::Tongue: return "tongue";
+    case FapDriver::Pupil: return "pupil";
     case FapDriver::Rigid: return "rigid";
     case FapDriver::None: return "none";
   }

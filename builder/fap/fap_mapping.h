@@ -27,6 +27,7 @@ enum class FapDriver {
   JawThrust,  // the jaw's forward translation: likewise
   JawShift,   // the jaw's sideways translation: likewise
   Tongue,     // the tongue part's kinematic motion (anatomy/tongue.h): a morph target
+  Pupil,      // an eye part's pupil dilation (anatomy/pupil.h): a morph target
   Rigid,      // eyeballs and head: a rigid part's control in the AFM, no target
   None,       // not synthesized; `note` says why
 };
@@ -70,13 +71,19 @@ struct FapMapping {
   std::vector<std::string> helpers;
 };
 
+// Whether FAP `fap`'s target is a part's own kinematic motion (the tongue's,
+// a pupil's), exact at its FDP by construction, rather than a solve of the
+// face model.
+bool kinematic_fap(int fap);
+
 // Every FAP 3..68 once, in number order.
 const std::vector<FapMapping> &fap_mappings();
 
 // The mapping of FAP `fap`, or nullptr when fap is not in 3..68.
 const FapMapping *find_fap_mapping(int fap);
 
-// "muscles", "jaw-open", "jaw-thrust", "jaw-shift", "tongue", "rigid", "none".
+// "muscles", "jaw-open", "jaw-thrust", "jaw-shift", "tongue", "pupil", "rigid",
+// "none".
 const char *fap_driver_name(FapDriver driver);
 
 // The 14 visemes and 6 expressions (FAP 1 and 2): each a fixed muscle

@@ -11,6 +11,7 @@
 #include <tuple>
 
 #include "afm/rigid_parts.h"
+#include "anatomy/pupil.h"
 #include "anatomy/skin_binding.h"
 #include "anatomy/tongue.h"
 #include "core/fapu.h"
@@ -242,7 +243,7 @@ CalibrationNeeds calibration_needs(const FapSynthesisOptions &options) {
 }
 
 bool solved_fap_target(const FapOutcome &o) {
-  return o.made && o.kind == AFM_TARGET_FAP && !is_tongue_fap(o.number);
+  return o.made && o.kind == AFM_TARGET_FAP && !kinematic_fap(o.number);
 }
 
 Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &model, const FapSynthesisOptions &options) {
@@ -487,12 +488,43 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     t.displacement[static_cast<size_t>(tongue->part)] = D;
     res.target = std::move(t);
   };
+  // A pupil FAP: the eye part's pupil dilates (anatomy/pupil.h), no solve.
+  // The FDP (the pupil's centre) stays: the outcome's prescribed and
+  // achieved motions are the growth of the pupil's diameter, along x.
+  auto make_pupil = [&](const FapMapping &map, int reference, Result &res) {
+    FapOutcome &o = res.outcome;
+    o.number = map.fap;
+    o.reference = reference;
+    const Expected<Pupil> pupil = find_pupil(scene, model.fdps, model.tissue.eyes, map.fap);
+    if (!pupil) {
+      o.message = pupil.status().message();
+      return;
+    }
+    if (!pupil_value_fits(*pupil, model.fapu, reference)) {
+      o.message = "the pupil would grow past its iris";
+      return;
+    }
+    const Eigen::MatrixXd &V = scene.parts[static_cast<size_t>(pupil->part)].V;
+    const Eigen::MatrixXd D = pupil_displacement(*pupil, V, model.fapu, reference);
+    o.prescribed = reference * model.fapu.irisd0 / 1024 * Eigen::Vector3d::UnitX();
+    const double grown = pupil_diameter(*pupil, V, V + D) - pupil_diameter(*pupil, V, V);
+    measure(o, grown * Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitX());
+    o.largest = D.rowwise().norm().maxCoeff();
+    o.made = true;
+    MorphTarget t;
+    t.kind = AFM_TARGET_FAP;
+    t.number = map.fap;
+    t.reference = reference;
+    t.displacement.assign(scene.parts.size(), Eigen::MatrixXd());
+    t.displacement[static_cast<size_t>(pupil->part)] = D;
+    res.target = std::move(t);
+  };
   auto make = [&](size_t k) {
     Result &res = results[k];
     if (work[k].high) return make_high_level(*work[k].high, res);
-    if (work[k].fap->driver == FapDriver::Tongue)
-      return make_tongue(*work[k].fap, work[k].side, work[k].reference, res);
     const FapMapping *map = work[k].fap;
+    if (map->driver == FapDriver::Tongue) return make_tongue(*map, work[k].side, work[k].reference, res);
+    if (map->driver == FapDriver::Pupil) return make_pupil(*map, work[k].reference, res);
     const int side = work[k].side, reference = work[k].reference;
     const auto start = std::chrono::steady_clock::now();
     const afm_fap_info *info = afm_fap(map->fap);
@@ -882,7 +914,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
   for (size_t k = 0; k < results.size(); ++k) {
     Result &r = results[k];
     if (r.target && r.target->displacement[static_cast<size_t>(model.skin)].rows() == 0) {
-      out.targets.push_back(std::move(*r.target));  // the skin does not move (the tongue's)
+      out.targets.push_back(std::move(*r.target));  // the skin does not move (the tongue's, a pupil's)
     } else if (r.target) {
       MorphTarget &t = *r.target;
       Eigen::MatrixXd &D = t.displacement[static_cast<size_t>(model.skin)];

@@ -15,6 +15,9 @@
 // (anatomy/tongue.h), exact at its FDP, where the face has a tongue with
 // FDPs 6.1-6.4 (else not made, and the outcome says what is missing). The
 // visemes add theirs (HighLevelMapping::tongue) under the jaw's motion.
+// Nor are the pupils' (29, 30): an eye part's pupil dilates where it has
+// pupil geometry (anatomy/pupil.h); their outcomes' prescribed and achieved
+// motions are the growth of the pupil's diameter, along x.
 //
 // In-betweens (FapMapping::farther; formats/afm.md): the same solve at each
 // farther reference, kept only where the group reaches it in full. The
@@ -134,9 +137,9 @@ struct FapOutcome {
 };
 
 // Whether a made outcome is a FAP target the face model solved (muscles,
-// jaw, lids): the ones the fidelity figures summarise. The tongue's
-// (anatomy/tongue.h) move their FDPs exactly by construction, and visemes
-// and expressions have no FDP rule.
+// jaw, lids): the ones the fidelity figures summarise. The tongue's and the
+// pupils' (kinematic_fap) are exact by construction, and visemes and
+// expressions have no FDP rule.
 bool solved_fap_target(const FapOutcome &o);
 
 struct FapSynthesisOptions {

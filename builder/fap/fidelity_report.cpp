@@ -13,6 +13,7 @@
 #include "core/atomic_file.h"
 #include "anatomy/jaw.h"
 #include "anatomy/tongue.h"
+#include "fap/fap_mapping.h"
 #include "fap/fap_synthesis.h"
 #include "render/scene_render.h"
 
@@ -113,7 +114,7 @@ std::string fidelity_table(const FapSynthesis &s) {
   std::string out = format("%-4s %-34s %6s %8s %10s %10s %8s %8s %7s %6s\n", "fap", "name", "ref", "scale",
                            "prescribed", "achieved", "along", "off-axis", "V_d", "turned");
   std::vector<double> along, off, off_face, off_depth, reach;
-  int failed = 0, turning = 0, turned = 0, tongue = 0;
+  int failed = 0, turning = 0, turned = 0, kinematic = 0;
   for (const FapOutcome &o : s.outcomes) {
     const std::string id = target_id(o);
     const std::string name = target_label(o);
@@ -132,12 +133,12 @@ std::string fidelity_table(const FapSynthesis &s) {
       continue;
     }
     if (!solved_fap_target(o)) {
-      // The tongue's: exact at its FDP by construction, not a measure of the
-      // face model (and left out of the summary's figures).
-      ++tongue;
-      out += format("%-4s %-34s %6d %8s %10.4g %10.4g %7.2f%% %7.1f%% %7s %6s  the tongue's own motion\n", id.c_str(),
+      // The tongue's or a pupil's: exact at the FDP by construction, not a
+      // measure of the face model (and left out of the summary's figures).
+      ++kinematic;
+      out += format("%-4s %-34s %6d %8s %10.4g %10.4g %7.2f%% %7.1f%% %7s %6s  the %s's own motion\n", id.c_str(),
                     name.c_str(), o.reference, "-", o.prescribed.norm(), o.achieved.norm(), 100 * o.along_error,
-                    100 * o.off_axis, "-", "-");
+                    100 * o.off_axis, "-", "-", is_tongue_fap(o.number) ? "tongue" : "pupil");
       continue;
     }
     along.push_back(o.along_error);
@@ -156,10 +157,11 @@ std::string fidelity_table(const FapSynthesis &s) {
                 s.targets.size(), failed, 100 * median(along), 100 * worst(along), 100 * median(off),
                 100 * worst(off), 100 * median(off_face), 100 * median(off_depth), reach.size(),
                 100 * median(reach), turning, turned,
-                tongue ? format("; the tongue's %d targets are exact by construction and not in these figures",
-                                tongue)
-                               .c_str()
-                       : "");
+                kinematic ? format("; %d targets of the tongue and pupils are exact by construction and not in "
+                                   "these figures",
+                                   kinematic)
+                                  .c_str()
+                          : "");
   return out;
 }
 
@@ -221,27 +223,33 @@ Status write_fidelity_report(const std::string &dir, const Scene &scene, const F
   };
   if (Status st = picture("neutral", scene, {}); !st) return st;
 
-  // A tongue target, which the closed lips hide: the lower teeth and the moved
-  // tongue from above and to the side, red where it moves, its rest shape
-  // in grey dots, its FDP at rest (yellow) and where MPEG-4 puts it (green).
-  auto tongue_picture = [&](const std::string &stem, const Scene &posed, const MorphTarget &t,
-                            const FapOutcome &o) -> Status {
-    Scene mouth;
-    mouth.name = posed.name;
-    mouth.units = posed.units;
-    mouth.source = posed.source;
+  // A target of a part the face hides or shows small: the tongue (the
+  // closed lips hide it) with the lower teeth, from above and to the side,
+  // red where it moves; a pupil, its eye alone from the front in its own
+  // colours. The part's rest vertices in grey dots, the tongue's FDP at rest
+  // (yellow) and where MPEG-4 puts it (green).
+  auto part_picture = [&](const std::string &stem, const Scene &posed, const MorphTarget &t,
+                          const FapOutcome &o) -> Status {
+    const bool tongue = is_tongue_fap(o.number);
+    const PartKind moved = tongue ? PartKind::Tongue : o.number == 29 ? PartKind::EyeLeft : PartKind::EyeRight;
+    Scene alone;
+    alone.name = posed.name;
+    alone.units = posed.units;
+    alone.source = posed.source;
     std::vector<SceneMarkers> markers;
     for (size_t p = 0; p < posed.parts.size(); ++p) {
       const PartKind k = posed.parts[p].kind;
-      if (k != PartKind::TeethLower && k != PartKind::Tongue) continue;
+      if (k != moved && !(tongue && k == PartKind::TeethLower)) continue;
       Part part = posed.parts[p];
-      if (k == PartKind::Tongue && p < t.displacement.size() && t.displacement[p].rows() == part.V.rows()) {
-        const Eigen::VectorXd len = t.displacement[p].rowwise().norm();
-        const double most = std::max(len.maxCoeff(), 1e-30);
-        part.C.resize(part.V.rows(), 3);
-        for (Eigen::Index v = 0; v < part.V.rows(); ++v) {
-          const double w = std::sqrt(std::min(1.0, len(v) / most));
-          part.C.row(v) = (1 - w) * Eigen::RowVector3d(0.8, 0.55, 0.55) + w * Eigen::RowVector3d(0.9, 0.1, 0.1);
+      if (k == moved && p < t.displacement.size() && t.displacement[p].rows() == part.V.rows()) {
+        if (tongue) {
+          const Eigen::VectorXd len = t.displacement[p].rowwise().norm();
+          const double most = std::max(len.maxCoeff(), 1e-30);
+          part.C.resize(part.V.rows(), 3);
+          for (Eigen::Index v = 0; v < part.V.rows(); ++v) {
+            const double w = std::sqrt(std::min(1.0, len(v) / most));
+            part.C.row(v) = (1 - w) * Eigen::RowVector3d(0.8, 0.55, 0.55) + w * Eigen::RowVector3d(0.9, 0.1, 0.1);
+          }
         }
         SceneMarkers rest;
         rest.points = scene.parts[p].V;
@@ -249,7 +257,8 @@ Status write_fidelity_report(const std::string &dir, const Scene &scene, const F
         rest.size_pixels = 2;
         markers.push_back(rest);
         const afm_fap_info *info = afm_fap(o.number);
-        if (const FdpPoint *f = fdps.find(FdpId{info->fdp_group, info->fdp_index}, static_cast<int>(p))) {
+        const FdpPoint *f = fdps.find(FdpId{info->fdp_group, info->fdp_index}, static_cast<int>(p));
+        if (tongue && f) {
           SceneMarkers at, goal;
           at.points = f->pos.transpose();
           at.color = {1.0f, 0.9f, 0.1f};
@@ -261,12 +270,12 @@ Status write_fidelity_report(const std::string &dir, const Scene &scene, const F
           markers.push_back(goal);
         }
       }
-      mouth.parts.push_back(std::move(part));
+      alone.parts.push_back(std::move(part));
     }
-    SceneRenderOptions mo = ro;
-    mo.face_closeup = false;
-    mo.views = {SceneView{50.0f, 25.0f}};
-    return picture(stem, mouth, markers, &mo);
+    SceneRenderOptions po = ro;
+    po.face_closeup = false;
+    po.views = {tongue ? SceneView{50.0f, 25.0f} : SceneView{}};
+    return picture(stem, alone, markers, &po);
   };
 
   size_t next = 0;  // targets are the made outcomes, in order
@@ -294,8 +303,8 @@ Status write_fidelity_report(const std::string &dir, const Scene &scene, const F
       }
       posed.parts[skin].C = C;
     }
-    if (o.kind == AFM_TARGET_FAP && is_tongue_fap(o.number)) {
-      if (Status st = tongue_picture(file_stem(o), posed, t, o); !st) return st;
+    if (o.kind == AFM_TARGET_FAP && kinematic_fap(o.number)) {
+      if (Status st = part_picture(file_stem(o), posed, t, o); !st) return st;
       continue;
     }
     std::vector<SceneMarkers> markers;

@@ -36,9 +36,10 @@ std::string target_label(const FapOutcome &outcome);
 // The table: a line per attempted target, ending in its outcome's message
 // where it has one (why it was not made, how far it under-reaches, which
 // helpers steered it, what was untangled), then one summary line: targets
-// made and not, and over the FAP targets the median and worst error along
-// the direction and off it, and the medians of the off-axis parts across
-// the face and in depth.
+// made and not, and over the FAP targets the model solved (solved_fap_target:
+// the tongue's and the pupils' are listed apart, exact by construction) the
+// median and worst error along the direction and off it, and the medians of
+// the off-axis parts across the face and in depth.
 std::string fidelity_table(const FapSynthesis &synthesis);
 
 struct FidelityReportOptions {

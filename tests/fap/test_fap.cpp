@@ -67,6 +67,7 @@ TEST(FapMapping, CoversEveryLowLevelFapOnceAndAgreesWithTheMpeg4Table) {
     if (m.driver == FapDriver::Tongue) {
       EXPECT_GT(m.reference, 0) << m.fap;
     }
+    EXPECT_EQ(m.driver == FapDriver::Pupil, info->motion == AFM_MOTION_DILATE) << m.fap;
     if (!info->bidirectional) {
       EXPECT_TRUE(m.negative.empty()) << m.fap << " is unidirectional";
     }
@@ -1060,57 +1061,65 @@ TEST(FapSynthesis, AFapThatIsTheSameSolveAsAnotherCopiesItsTarget) {
   EXPECT_EQ(both->outcomes[1].achieved, alone->outcomes[0].achieved);
 }
 
-// The tongue's FAPs (anatomy/tongue.h) on a head that has one: each made,
-// moving the tongue alone and its FDP by reference x FAPU along the table's
-// direction, in the AFM too (to half a quantum); 45 with a negative side of
-// its own; and left out of the report's figures, which measure the muscles.
-TEST(FapSynthesis, TheTongueFapsMoveTheTongueAloneAndItsFdpByTheMpeg4Rule) {
+// The tongue's FAPs (anatomy/tongue.h) and the pupils' (anatomy/pupil.h) on
+// a head that has both: each made, moving its part alone and its FDP by
+// reference x FAPU along the table's direction (a pupil's diameter grows by
+// it, its centre stays), in the AFM too (to half a quantum); 45 with a
+// negative side of its own; and left out of the report's figures, which
+// measure the muscles.
+TEST(FapSynthesis, TheTongueAndPupilFapsMoveTheirPartAloneByTheMpeg4Rule) {
   const Built &b = head_1k();
   FapSynthesisOptions o;
-  o.only = {43, 44, 45, 46, 47};
+  o.only = {29, 30, 43, 44, 45, 46, 47};
   Expected<FapSynthesis> s = synthesize_faps(b.head.scene, b.model, o);
   ASSERT_TRUE(s.is_ok()) << s.status().message();
-  ASSERT_EQ(s->outcomes.size(), 6u);
-  ASSERT_EQ(s->targets.size(), 6u);
-  const int tongue = b.head.scene.find_kind(PartKind::Tongue);
-  ASSERT_GE(tongue, 0);
-  const Eigen::MatrixXd &V = b.head.scene.parts[static_cast<size_t>(tongue)].V;
+  ASSERT_EQ(s->outcomes.size(), 8u);
+  ASSERT_EQ(s->targets.size(), 8u);
+  auto part_of = [&b](int fap) {
+    return b.head.scene.find_kind(fap == 29 ? PartKind::EyeLeft : fap == 30 ? PartKind::EyeRight : PartKind::Tongue);
+  };
   for (size_t k = 0; k < s->outcomes.size(); ++k) {
     const FapOutcome &oc = s->outcomes[k];
     const MorphTarget &t = s->targets[k];
     SCOPED_TRACE("FAP " + std::to_string(oc.number) + " side " + std::to_string(oc.side));
     ASSERT_TRUE(oc.made) << oc.message;
     EXPECT_FALSE(solved_fap_target(oc));
-    EXPECT_EQ(oc.side < 0, oc.number == 45 && k == 3) << "only the thrust has its own negative side";
+    EXPECT_EQ(oc.side < 0, oc.number == 45 && k == 5) << "only the thrust has its own negative side";
+    const int moving = part_of(oc.number);
+    ASSERT_GE(moving, 0);
     for (size_t p = 0; p < t.displacement.size(); ++p)
-      if (static_cast<int>(p) != tongue) {
+      if (static_cast<int>(p) != moving) {
         EXPECT_TRUE(t.displacement[p].size() == 0 || t.displacement[p].isZero()) << "part " << p;
       }
-    const Eigen::MatrixXd &D = t.displacement[static_cast<size_t>(tongue)];
-    ASSERT_EQ(D.rows(), V.rows());
+    const Eigen::MatrixXd &D = t.displacement[static_cast<size_t>(moving)];
+    ASSERT_EQ(D.rows(), b.head.scene.parts[static_cast<size_t>(moving)].V.rows());
     const afm_fap_info *info = afm_fap(oc.number);
-    const FdpPoint *f = b.head.fdps.find(FdpId{info->fdp_group, info->fdp_index}, tongue);
-    ASSERT_TRUE(f && f->part == tongue);
+    const FdpPoint *f = b.head.fdps.find(FdpId{info->fdp_group, info->fdp_index}, moving);
+    ASSERT_TRUE(f && f->part == moving);
     const Eigen::Vector3d moved = D.row(f->vertex).transpose();
-    if (oc.number == 47) {
+    const double value = t.reference * fapu_distance(b.model.fapu, info->unit) / 1024;
+    if (oc.number == 29 || oc.number == 30) {
+      EXPECT_EQ(moved.norm(), 0) << "the pupil's centre stays";
+      EXPECT_NEAR(oc.achieved.x(), value, 1e-9 * value) << "the diameter's growth";
+    } else if (oc.number == 47) {
       // Concave upward: both borders rise alike.
-      const FdpPoint *right = b.head.fdps.find(FdpId{6, 4}, tongue);
+      const FdpPoint *right = b.head.fdps.find(FdpId{6, 4}, moving);
       ASSERT_TRUE(right);
       EXPECT_GT(moved.y(), 0);
       EXPECT_NEAR(D(right->vertex, 1), moved.y(), 1e-9);
     } else {
-      const Eigen::Vector3d want = t.reference * fapu_distance(b.model.fapu, info->unit) / 1024 * direction_of(oc.number);
+      const Eigen::Vector3d want = value * direction_of(oc.number);
       EXPECT_LT((moved - want).norm(), 1e-12) << moved.transpose() << " against " << want.transpose();
     }
   }
-  EXPECT_NE(fidelity_table(*s).find("the tongue's 6 targets are exact by construction"), std::string::npos);
+  EXPECT_NE(fidelity_table(*s).find("8 targets of the tongue and pupils are exact by construction"), std::string::npos);
 
-  // Through the AFM: the stored deltas of the tongue are the builder's.
+  // Through the AFM: the stored deltas of the moving part are the builder's.
   const AfmContent content = fap_afm_content(b.head.scene, b.head.fdps, b.model, *s);
   const DocPtr hold = encoded_doc(content);
   ASSERT_NE(hold.get(), nullptr);
   const afm_doc *doc = hold.get();
-  ASSERT_EQ(doc->target_count, 6u);
+  ASSERT_EQ(doc->target_count, 8u);
   const RenderVertices rv = afm_render_vertices(content);
   std::vector<int32_t> q15(3 * size_t(afm_doc_entry_count(doc)));
   for (uint32_t i = 0; i < doc->target_count; ++i) {
@@ -1119,10 +1128,11 @@ TEST(FapSynthesis, TheTongueFapsMoveTheTongueAloneAndItsFdpByTheMpeg4Rule) {
     ASSERT_EQ(int(at.number), t.number);
     ASSERT_EQ(at.reference, t.reference);
     ASSERT_EQ(afm_target_expand(doc, &at, q15.data()), AFM_OK);
-    const Eigen::MatrixXd &D = t.displacement[static_cast<size_t>(tongue)];
+    const size_t moving = static_cast<size_t>(part_of(t.number));
+    const Eigen::MatrixXd &D = t.displacement[moving];
     double worst = 0;
     for (Eigen::Index w = 0; w < D.rows(); ++w)
-      for (uint32_t v : rv.copies[static_cast<size_t>(tongue)][size_t(w)])
+      for (uint32_t v : rv.copies[moving][size_t(w)])
         for (int c = 0; c < 3; ++c)
           worst = std::max(worst, std::abs(q15[3 * size_t(v) + size_t(c)] / 32768.0 - D(w, c) / doc->geometry.step));
     EXPECT_LE(worst, 0.5 + 1e-6) << "FAP " << t.number;

@@ -1,7 +1,10 @@
-// The tongue's motions (anatomy/tongue.h) against the MPEG-4 table and the
-// tongue's physics: each FAP moves its FDP by value x FAPU the way the table
-// says, the root stays, and the tongue keeps its volume where it bends and
-// stretches (a muscular hydrostat).
+// The parts that move by their own kinematic models, against MPEG-4 and
+// their physics. The tongue (anatomy/tongue.h): each FAP moves its FDP by
+// value x FAPU the way the table says, the root stays, and the tongue keeps
+// its volume where it bends and stretches (a muscular hydrostat). The pupils
+// (anatomy/pupil.h): the neutral pupil is a third of the iris (the FAPU
+// notes), FAPs 29 and 30 grow its diameter by value x IRISD, the pupil's
+// centre (the FDP) stays, the eye stays a sphere and its white does not move.
 #include <afm/mpeg4.h>
 #include <gtest/gtest.h>
 
@@ -12,6 +15,8 @@
 #include <functional>
 #include <memory>
 
+#include "anatomy/pupil.h"
+#include "anatomy/skin_model.h"
 #include "anatomy/tongue.h"
 #include "core/fapu.h"
 #include "refhead/refhead.h"
@@ -26,6 +31,7 @@ struct Head {
   Tongue tongue;
   const Eigen::MatrixXd *V = nullptr;  // the tongue's rest vertices
   Eigen::MatrixXi F;
+  std::vector<EyeSphere> eyes;
 };
 
 const Head &head() {
@@ -46,6 +52,7 @@ const Head &head() {
     const Part &p = h->head.scene.parts[static_cast<size_t>(t->part)];
     h->V = &p.V;
     h->F = p.F;
+    h->eyes = fit_eyeballs(h->head.scene);
   }
   return *h;
 }
@@ -175,4 +182,63 @@ TEST(Tongue, BadTongueFdpsAreNamed) {
   const Expected<Tongue> t = find_tongue(none, head().head.fdps);
   ASSERT_FALSE(t.is_ok());
   EXPECT_NE(t.status().message().find("no tongue part"), std::string::npos) << t.status().message();
+}
+
+TEST(Pupil, EachFapGrowsItsPupilsDiameterByValueTimesIrisd) {
+  const Head &e = head();
+  ASSERT_EQ(e.eyes.size(), 2u);
+  for (int fap : {29, 30}) {
+    SCOPED_TRACE("FAP " + std::to_string(fap));
+    const Expected<Pupil> p = find_pupil(e.head.scene, e.head.fdps, e.eyes, fap);
+    ASSERT_TRUE(p.is_ok()) << p.status().message();
+    const afm_fap_info *info = afm_fap(fap);
+    const FdpPoint *f = e.head.fdps.find(FdpId{info->fdp_group, info->fdp_index});
+    ASSERT_TRUE(f && f->part == p->part);
+    const Eigen::MatrixXd &V = e.head.scene.parts[static_cast<size_t>(p->part)].V;
+    // MPEG-4's neutral face: the pupil a third of the iris' diameter, IRISD0.
+    const double rest = pupil_diameter(*p, V, V);
+    EXPECT_NEAR(rest, e.fapu.irisd0 / 3, 0.05 * e.fapu.irisd0 / 3);
+    for (double value : {-150.0, 100.0, 300.0}) {
+      ASSERT_TRUE(pupil_value_fits(*p, e.fapu, value)) << value;
+      const Eigen::MatrixXd D = pupil_displacement(*p, V, e.fapu, value);
+      ASSERT_TRUE(D.allFinite());
+      EXPECT_NEAR(pupil_diameter(*p, V, V + D) - rest, value * e.fapu.irisd0 / 1024, 1e-9 * e.fapu.irisd0) << value;
+      EXPECT_EQ(D.row(f->vertex).norm(), 0) << "the pupil's centre, FDP " << info->fdp_group << "." << info->fdp_index;
+      int moved = 0;
+      for (Eigen::Index v = 0; v < V.rows(); ++v) {
+        const Eigen::Vector3d x = V.row(v).transpose(), y = x + D.row(v).transpose();
+        EXPECT_NEAR((y - p->centre).norm(), (x - p->centre).norm(), 1e-12) << "on its sphere";
+        // The white of the eye (beyond 1.2 times the iris' edge) stays.
+        const double polar = std::acos(std::clamp((x - p->centre).normalized().dot(p->axis), -1.0, 1.0));
+        if (polar > 1.2 * p->iris) EXPECT_EQ(D.row(v).norm(), 0) << v;
+        moved += D.row(v).norm() > 0;
+      }
+      EXPECT_GT(moved, 0);
+    }
+    // Past the iris, or closed: refused.
+    EXPECT_FALSE(pupil_value_fits(*p, e.fapu, 1024));
+    EXPECT_FALSE(pupil_value_fits(*p, e.fapu, -400));
+  }
+}
+
+TEST(Pupil, AnEyeWithoutPupilGeometryIsNamed) {
+  const Head &e = head();
+  // A textured eye (Song's): no vertex colours.
+  Scene bare = e.head.scene;
+  for (Part &p : bare.parts)
+    if (p.kind == PartKind::EyeLeft) p.C.resize(0, 3);
+  const Expected<Pupil> t = find_pupil(bare, e.head.fdps, e.eyes, 29);
+  ASSERT_FALSE(t.is_ok());
+  EXPECT_NE(t.status().message().find("no vertex colours"), std::string::npos) << t.status().message();
+  // A pale eye: no dark disc.
+  Scene pale = e.head.scene;
+  for (Part &p : pale.parts)
+    if (p.kind == PartKind::EyeRight) p.C.setConstant(0.9);
+  const Expected<Pupil> u = find_pupil(pale, e.head.fdps, e.eyes, 30);
+  ASSERT_FALSE(u.is_ok());
+  EXPECT_NE(u.status().message().find("not dark"), std::string::npos) << u.status().message();
+  // No eyeball under the FDP.
+  const Expected<Pupil> v = find_pupil(e.head.scene, e.head.fdps, {}, 29);
+  ASSERT_FALSE(v.is_ok());
+  EXPECT_NE(v.status().message().find("3.5"), std::string::npos) << v.status().message();
 }
