@@ -48,7 +48,8 @@ Expected<Pupil> find_pupil(const Scene &scene, const FdpSet &fdps, const std::ve
   p.centre = eye->centre;
   p.radius = eye->radius;
   const Eigen::Vector3d out = f->pos - p.centre;
-  if (!(out.norm() > 0.5 * p.radius)) return Status::error(scene.source + ": FDP " + id.str() + " lies inside its eyeball");
+  if (!(out.norm() > 0.5 * p.radius))
+    return Status::error(scene.source + ": FDP " + id.str() + " lies inside its eyeball");
   p.axis = out.normalized();
   const std::string what = scene.source + ": the eye part " + part.name;
   if (part.C.rows() != part.V.rows())

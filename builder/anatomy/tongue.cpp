@@ -61,7 +61,8 @@ Expected<Tongue> find_tongue(const Scene &scene, const FdpSet &fdps) {
   for (int i = 0; i < 4; ++i) {
     const FdpId id{6, i + 1};
     const FdpPoint *p = fdps.find(id, t.part);
-    if (!p || p->part != t.part || p->vertex < 0) return Status::error(scene.source + ": FDP " + id.str() + " is not on the tongue part " + part.name);
+    if (!p || p->part != t.part || p->vertex < 0)
+      return Status::error(scene.source + ": FDP " + id.str() + " is not on the tongue part " + part.name);
     *key[i] = p->pos;
   }
   t.root_z = part.V.col(2).minCoeff();

@@ -168,13 +168,13 @@ std::vector<HighLevelMapping> make_high_level_table() {
     double percent;
   };
   auto add = [&](bool expression, int number, int jaw, std::vector<Pair> pairs, const char *note,
-                 std::vector<std::pair<int, int>> tongue = {}) {
+                 std::vector<std::pair<int, int>> parts = {}) {
     HighLevelMapping m;
     m.expression = expression;
     m.number = number;
     m.jaw_open = jaw;
     m.note = note;
-    m.tongue = std::move(tongue);
+    m.parts = std::move(parts);
     for (const Pair &p : pairs) {
       const std::string name = p.muscle;
       if (name == "orbicularis_oris") m.muscles.push_back({name, p.percent});
@@ -209,6 +209,8 @@ std::vector<HighLevelMapping> make_high_level_table() {
   add(false, 14, 90, {{"orbicularis_oris", 90}}, "lips tightly rounded and pushed out, tongue back up",
       {{46, 200}});
   // ---- expressions (ISO/IEC 14496-2 Table C-3) ----
+  // Fear widens the pupils (the sympathetic response; FAPs 29, 30, reference
+  // 300 IRISD units), surprise a little.
   add(true, 1, 40,
       {{"zygomaticus_major", 100}, {"zygomaticus_minor", 50}, {"risorius", 20}, {"orbicularis_oculi", 40}},
       "joy: corners up and back, cheeks raised, eyes narrowed");
@@ -220,13 +222,13 @@ std::vector<HighLevelMapping> make_high_level_table() {
   add(true, 4, 80,
       {{"frontalis_inner", 100}, {"frontalis_major", 50}, {"corrugator", 40}, {"risorius", 70},
        {"orbicularis_oculi", -50}},
-      "fear: brows up and together, eyes wide, lips stretched, jaw dropped");
+      "fear: brows up and together, eyes wide, pupils wide, lips stretched, jaw dropped", {{29, 200}, {30, 200}});
   add(true, 5, 0,
       {{"upper_lip", -100}, {"nasalis", 60}, {"corrugator", 40}, {"depressor_anguli", 30}, {"mentalis", 30}},
       "disgust: upper lip raised, nose wrinkled, brows lowered");
   add(true, 6, 220,
       {{"frontalis_inner", 100}, {"frontalis_major", 100}, {"frontalis_outer", 100}, {"orbicularis_oculi", -60}},
-      "surprise: brows raised, eyes wide, jaw dropped");
+      "surprise: brows raised, eyes wide, pupils a little wide, jaw dropped", {{29, 100}, {30, 100}});
   return t;
 }
 
@@ -304,9 +306,9 @@ std::string fap_mapping_text() {
     out += head;
     if (m.jaw_open) out += "  jaw " + std::to_string(m.jaw_open);
     if (!m.muscles.empty()) out += "  + " + group(m.muscles);
-    for (size_t k = 0; k < m.tongue.size(); ++k)
-      out += (k ? ", " : "  tongue ") + std::to_string(m.tongue[k].first) + " " +
-             (m.tongue[k].second > 0 ? "+" : "") + std::to_string(m.tongue[k].second);
+    for (size_t k = 0; k < m.parts.size(); ++k)
+      out += (k ? ", " : "  FAPs ") + std::to_string(m.parts[k].first) + " " +
+             (m.parts[k].second > 0 ? "+" : "") + std::to_string(m.parts[k].second);
     out += std::string("  (") + m.note + ")\n";
   }
   return out;

@@ -96,10 +96,10 @@ struct HighLevelMapping {
   int number = 0;                           // viseme 1..14, expression 1..6
   std::vector<FapContraction> muscles;      // percent of each muscle's calibrated range
   int jaw_open = 0;                         // FAP 3 (open_jaw) units, MNS/1024: how far the chin drops
-  // The tongue's FAPs (43-47) and their values, FAP units: its motion
-  // (anatomy/tongue.h) in the target, under the jaw's, where the face has a
-  // tongue.
-  std::vector<std::pair<int, int>> tongue;
+  // The tongue's and the pupils' FAPs (43-47; 29, 30) and their values, FAP
+  // units: their own motions (anatomy/tongue.h, pupil.h) in the target, the
+  // tongue's under the jaw's, where the face has them.
+  std::vector<std::pair<int, int>> parts;
   const char *note = "";                    // what the face does
 };
 

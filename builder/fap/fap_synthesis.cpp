@@ -327,8 +327,23 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         a.muscles.push_back({i, c.percent});
     }
     if (!missing.empty()) o.message = "without " + missing + ": not in the model or not calibrated";
-    if (!h.tongue.empty() && !tongue)
-      o.message += std::string(o.message.empty() ? "" : "; ") + "without the tongue: " + tongue.status().message();
+    // The tongue's and the pupils' own motions (HighLevelMapping::parts).
+    std::vector<std::pair<int, int>> shape_tongue;
+    std::vector<std::pair<Pupil, int>> pupils;
+    for (const auto &[fap, value] : h.parts) {
+      std::string without;
+      if (is_tongue_fap(fap)) {
+        if (tongue) shape_tongue.push_back({fap, value});
+        else without = "the tongue: " + tongue.status().message();
+      } else if (Expected<Pupil> p = find_pupil(scene, model.fdps, model.tissue.eyes, fap); !p) {
+        without = "the pupil: " + p.status().message();
+      } else if (!pupil_value_fits(*p, model.fapu, value)) {
+        without = "the pupil: it would grow past its iris";
+      } else {
+        pupils.push_back({*p, value});
+      }
+      if (!without.empty()) o.message += std::string(o.message.empty() ? "" : "; ") + "without " + without;
+    }
     Eigen::Affine3d jaw = Eigen::Affine3d::Identity();
     if (h.jaw_open > 0) {
       // The chin (2.1) drops by jaw_open FAP 3 units, as the bone carries it.
@@ -437,12 +452,16 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         // No rigid control serves FAP 1 or 2: the jaw's parts move in the
         // target itself, the tongue in its own shape first.
         Eigen::MatrixXd shaped;  // the tongue's displacement before the jaw's
-        if (!h.tongue.empty() && tongue) {
+        if (!shape_tongue.empty()) {
           const Eigen::MatrixXd &V = scene.parts[static_cast<size_t>(tongue->part)].V;
           shaped = Eigen::MatrixXd::Zero(V.rows(), 3);
-          for (const auto &[fap, value] : h.tongue) shaped += tongue_displacement(*tongue, V, model.fapu, fap, value);
+          for (const auto &[fap, value] : shape_tongue)
+            shaped += tongue_displacement(*tongue, V, model.fapu, fap, value);
           t.displacement[static_cast<size_t>(tongue->part)] = shaped;
         }
+        for (const auto &[pupil, value] : pupils)
+          t.displacement[static_cast<size_t>(pupil.part)] =
+              pupil_displacement(pupil, scene.parts[static_cast<size_t>(pupil.part)].V, model.fapu, value);
         if (!jaw.matrix().isIdentity(0))
           for (int p : out.jaw.parts) {
             const Eigen::MatrixXd &V = scene.parts[static_cast<size_t>(p)].V;

@@ -14,10 +14,11 @@
 // The tongue's FAPs (43-47) are no solve: the tongue part's own motion
 // (anatomy/tongue.h), exact at its FDP, where the face has a tongue with
 // FDPs 6.1-6.4 (else not made, and the outcome says what is missing). The
-// visemes add theirs (HighLevelMapping::tongue) under the jaw's motion.
+// visemes add theirs (HighLevelMapping::parts) under the jaw's motion.
 // Nor are the pupils' (29, 30): an eye part's pupil dilates where it has
 // pupil geometry (anatomy/pupil.h); their outcomes' prescribed and achieved
-// motions are the growth of the pupil's diameter, along x.
+// motions are the growth of the pupil's diameter, along x. Fear and
+// surprise widen them.
 //
 // In-betweens (FapMapping::farther; formats/afm.md): the same solve at each
 // farther reference, kept only where the group reaches it in full. The

@@ -210,7 +210,9 @@ TEST(Pupil, EachFapGrowsItsPupilsDiameterByValueTimesIrisd) {
         EXPECT_NEAR((y - p->centre).norm(), (x - p->centre).norm(), 1e-12) << "on its sphere";
         // The white of the eye (beyond 1.2 times the iris' edge) stays.
         const double polar = std::acos(std::clamp((x - p->centre).normalized().dot(p->axis), -1.0, 1.0));
-        if (polar > 1.2 * p->iris) EXPECT_EQ(D.row(v).norm(), 0) << v;
+        if (polar > 1.2 * p->iris) {
+          EXPECT_EQ(D.row(v).norm(), 0) << v;
+        }
         moved += D.row(v).norm() > 0;
       }
       EXPECT_GT(moved, 0);

@@ -19,6 +19,7 @@
 #include "anatomy/jaw.h"
 #include "anatomy/muscle_table.h"
 #include "anatomy/muscles.h"
+#include "anatomy/pupil.h"
 #include "anatomy/sim_mesh.h"
 #include "anatomy/skin_binding.h"
 #include "anatomy/solver.h"
@@ -534,6 +535,31 @@ TEST(HighLevel, TheVisemesPutTheTongueWherePhoneticsSays) {
   ASSERT_EQ(n->outcomes.size(), 1u);
   EXPECT_TRUE(n->outcomes[0].made);
   EXPECT_NE(n->outcomes[0].message.find("without the tongue"), std::string::npos) << n->outcomes[0].message;
+}
+
+// Fear widens both pupils (fap_mapping.cpp: FAPs 29 and 30 at 200 IRISD
+// units in its table row): each eye's pupil diameter grows by 200 x IRISD0 /
+// 1024, and neither eye's white moves.
+TEST(HighLevel, FearWidensThePupils) {
+  const Built &b = head_1k();
+  FapSynthesisOptions o;
+  o.only_expressions = {4};
+  Expected<FapSynthesis> s = synthesize_faps(b.head.scene, b.model, o);
+  ASSERT_TRUE(s.is_ok()) << s.status().message();
+  ASSERT_EQ(s->targets.size(), 1u);
+  const MorphTarget &fear = s->targets[0];
+  for (int fap : {29, 30}) {
+    const Expected<Pupil> p = find_pupil(b.head.scene, b.head.fdps, b.model.tissue.eyes, fap);
+    ASSERT_TRUE(p.is_ok()) << p.status().message();
+    const Eigen::MatrixXd &V = b.head.scene.parts[static_cast<size_t>(p->part)].V;
+    const Eigen::MatrixXd &D = fear.displacement[static_cast<size_t>(p->part)];
+    ASSERT_EQ(D.rows(), V.rows()) << "FAP " << fap << ": the eye does not move";
+    EXPECT_NEAR(pupil_diameter(*p, V, V + D) - pupil_diameter(*p, V, V), 200 * b.model.fapu.irisd0 / 1024,
+                1e-9 * b.model.fapu.irisd0);
+    int white = 0;
+    for (Eigen::Index v = 0; v < V.rows(); ++v) white += D.row(v).norm() == 0;
+    EXPECT_GT(white, V.rows() / 2) << "the white of the eye stays";
+  }
 }
 
 // Joy raises the left mouth corner (8.3) and draws it outward, as FAPs 59
