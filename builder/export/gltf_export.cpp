@@ -357,7 +357,9 @@ class GltfBuilder {
     Accessor a;
     a.count = p.vertex_count;
     a.type = "VEC3";
-    Glb::set_bounds(&a, val, 3, true);
+    // The vertices left out are zeros; where the target moves every vertex of
+    // the part (the jaw's teeth in a viseme) there are none.
+    Glb::set_bounds(&a, val, 3, idx.size() < p.vertex_count);
     if (!idx.empty()) {
       a.sparse_count = idx.size();
       if (p.vertex_count <= 65535) {
