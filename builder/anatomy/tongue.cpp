@@ -73,7 +73,7 @@ Expected<Tongue> find_tongue(const Scene &scene, const FdpSet &fdps) {
   if (!(t.body_s > 0.05 && t.body_s < 0.95))
     return Status::error(scene.source + ": FDP 6.2 is not between the tongue's root and its tip (at " +
                          std::to_string(t.body_s) + " of the way)");
-  t.border_s = place(t, 0.5 * (t.left + t.right));
+  t.border_s = std::min(place(t, t.left), place(t, t.right));  // both borders turn in full
   if (!(t.border_s > 0.05))
     return Status::error(scene.source + ": FDPs 6.3 and 6.4 lie at the tongue's root");
   t.hinge_y = 0.5 * (t.left.y() + t.right.y());

@@ -124,6 +124,22 @@ TEST(Tongue, TheRollTurnsBothBordersUpByTheFapsAngle) {
   EXPECT_NEAR(D(fdp(3).vertex, 0), -D(fdp(4).vertex, 0), 1e-9);
   // The midline does not move.
   EXPECT_LT(D.row(fdp(1).vertex).norm(), 1e-15);
+  // Borders at different places along the tongue (6.4 a tenth of its
+  // length further back) still both turn by the angle.
+  const Expected<Tongue> skew = tongue_with([&h](FdpSet &f) {
+    for (FdpPoint &p : f.points)
+      if (p.id == FdpId{6, 4}) p.pos.z() -= 0.1 * h.tongue.length;
+  });
+  ASSERT_TRUE(skew.is_ok()) << skew.status().message();
+  Eigen::MatrixXd B(2, 3);
+  B << skew->left.transpose(), skew->right.transpose();
+  const Eigen::MatrixXd DB = tongue_displacement(*skew, B, h.fapu, 47, value);
+  for (int r = 0; r < 2; ++r) {
+    const Eigen::Vector2d before(B(r, 0) - skew->tip.x(), B(r, 1) - skew->hinge_y);
+    const Eigen::Vector2d after = before + DB.row(r).head<2>().transpose();
+    const double turned = std::atan2(std::abs(before.x() * after.y() - before.y() * after.x()), before.dot(after));
+    EXPECT_NEAR(turned, value * 1e-5, 1e-9) << (r ? "6.4" : "6.3") << ", the one further back";
+  }
 }
 
 TEST(Tongue, TheRootStaysAndTheTongueKeepsItsVolume) {
