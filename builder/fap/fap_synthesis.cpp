@@ -342,7 +342,9 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       } else {
         pupils.push_back({*p, value});
       }
-      if (!without.empty()) o.message += std::string(o.message.empty() ? "" : "; ") + "without " + without;
+      without = "without " + without;  // once per part: a viseme may send the tongue several FAPs
+      if (without != "without " && o.message.find(without) == std::string::npos)
+        o.message += std::string(o.message.empty() ? "" : "; ") + without;
     }
     Eigen::Affine3d jaw = Eigen::Affine3d::Identity();
     if (h.jaw_open > 0) {
