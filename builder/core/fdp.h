@@ -70,6 +70,39 @@ struct FdpSet {
 // error `fdps` may be partly bound.
 Status bind_fdps(FdpSet &fdps, const Scene &scene);
 
+// Attaches each free point that lies on the mesh to the vertex it lies on,
+// so that a file of coordinates (a visage file without mesh indices, a text
+// file of `FDP X Y Z` lines) drives the face as part + vertex points do. A
+// point's candidates are the vertices of the parts of its own kind
+// (fdp_part_kind(): the pupils on the eyes, 6.x on the tongue, the incisors
+// on the teeth, every other FDP on the skin) when the scene's parts are
+// named so (guess_part_kinds), else of every part; the nearest within
+// `tolerance` (model units) wins. Among vertices at one position, the lips'
+// and lids' points take the one on their side (2.2 the one whose triangles
+// lie above, 2.3 below: a closed mouth's inner contours coincide), others
+// the lowest index (an exporter's split seam). The point
+// then gets that part, its name and vertex, and the vertex's own position.
+// Points farther from every candidate stay free: FDP 7.1, the top of the
+// spine, lies inside the neck. A free point whose FDP the set already has on
+// the part found also stays free (one point per FDP and part).
+struct FreeFdpAttachment {
+  int attached = 0;
+  double farthest = 0;        // model units, of the attached points
+  // Into fdps.points (valid while it is not resized): the attached point
+  // that lay farthest, and the points that stay free.
+  const FdpPoint *at = nullptr;
+  std::vector<const FdpPoint *> free;
+};
+FreeFdpAttachment attach_free_fdps(FdpSet &fdps, const Scene &scene, double tolerance);
+
+// The nearest vertex to `pos` over every part: {part, vertex, distance}, or
+// part -1 in a scene without vertices. For messages about points left free.
+struct NearestVertex {
+  int part = -1, vertex = -1;
+  double distance = 0;
+};
+NearestVertex nearest_vertex(const Scene &scene, const Eigen::Vector3d &pos);
+
 // "song.fdp:57: FDP 2.2", the prefix of every message about one point ("song.fdp:
 // FDP 2.2" when the line is unknown, "FDP 2.2" when the source is too).
 std::string fdp_location(const FdpSet &fdps, const FdpPoint &point);

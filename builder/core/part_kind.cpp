@@ -75,6 +75,15 @@ void guess_part_kinds(Scene &scene) {
   for (Part &p : scene.parts) p.kind = guess_part_kind(p);
 }
 
+PartKind fdp_part_kind(FdpId id) {
+  if (id == FdpId{3, 5}) return PartKind::EyeLeft;
+  if (id == FdpId{3, 6}) return PartKind::EyeRight;
+  if (id.group == 6) return PartKind::Tongue;
+  if (id == FdpId{9, 8} || id == FdpId{9, 10}) return PartKind::TeethUpper;
+  if (id == FdpId{9, 9} || id == FdpId{9, 11}) return PartKind::TeethLower;
+  return PartKind::Skin;
+}
+
 void assign_part_kinds(Scene &scene, const FdpSet &bound) {
   const int n = static_cast<int>(scene.parts.size());
   std::vector<int> face_fdps(n, 0);   // FDPs of groups 2, 4, 5, 8, 9 per part

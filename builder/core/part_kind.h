@@ -35,6 +35,12 @@ PartKind guess_part_kind(const Part &part);
 // Sets every part's kind from its names (guess_part_kind).
 void guess_part_kinds(Scene &scene);
 
+// The kind of part an FDP lies on in MPEG-4's list: 3.5 EyeLeft, 3.6
+// EyeRight, 6.1-6.4 Tongue, 9.8 and 9.10 TeethUpper, 9.9 and 9.11
+// TeethLower, every other one Skin (7.1, the top of the spine, too: no part
+// holds it). 2.1 is also on the lower teeth in Song's file; Skin here.
+PartKind fdp_part_kind(FdpId id);
+
 // Corrects the kinds with a bound FDP set:
 //   Skin:  the part holding FDP 2.1 (chin) with the most FDPs of groups 2, 4,
 //          5, 8 and 9 (Song has 2.1 on the head and on the lower teeth);

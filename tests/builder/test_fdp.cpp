@@ -142,6 +142,88 @@ TEST(BindFdps, ErrorsNameFileLineFdpPartAndVertexCount) {
   EXPECT_TRUE(contains(s.message(), "song.fdp:59: FDP 3.6: part '@3' not in small.wrl")) << s.message();
 }
 
+// ---- Free points attached to the mesh ------------------------------------------
+
+// A skin with a closed mouth's two coincident inner-lip vertices (1 above the
+// slit's line, 2 below: each has its own triangle), an eye part whose front
+// vertex lies just behind a lid vertex, and a second skin vertex at vertex 3's
+// place that no triangle uses.
+Scene lips_scene() {
+  Scene s;
+  afmb::Part skin;
+  skin.name = "face";
+  skin.V.resize(7, 3);
+  skin.V << 0, 0, 0,  //
+      1, 0, 0,        // upper inner lip
+      1, 0, 0,        // lower inner lip, same place
+      0, 5, 0,        //
+      0, -5, 0,       //
+      3, 3, 1,        // a lid vertex
+      0, 5, 0;        // vertex 3 again, unused
+  skin.F.resize(2, 3);
+  skin.F << 0, 1, 3,  // above: the upper lip's triangle
+      0, 4, 2;        // below: the lower lip's
+  skin.kind = afmb::PartKind::Skin;
+  afmb::Part eye;
+  eye.name = "eye_left";
+  eye.kind = afmb::PartKind::EyeLeft;
+  eye.V.resize(2, 3);
+  eye.V << 3, 3, 0.99,  // 0.01 behind the lid vertex
+      3, 3, 0;
+  s.parts = {skin, eye};
+  return s;
+}
+
+TEST(AttachFreeFdps, PutsEachOnTheVertexOfItsOwnPartAndSide) {
+  const Scene scene = lips_scene();
+  FdpSet set;
+  set.points.push_back(free_point(2, 3, 1, 0, 1e-7, 1));       // the lower lip's point, printed to 7 places
+  set.points.push_back(free_point(2, 2, 1, 0, 0, 2));          // the upper lip's, at the same place
+  set.points.push_back(free_point(3, 1, 3, 3, 0.995, 3));      // a lid point: the skin, though the eye is as near
+  set.points.push_back(free_point(3, 5, 3, 3, 1, 4));          // the pupil: the eye, though the skin is nearer
+  set.points.push_back(free_point(7, 1, 0, 0, -3, 5));         // the spine, inside: stays free
+  set.points.push_back(free_point(9, 3, 0, 5, 0.001, 6));      // vertex 3, not its unused copy 6
+  set.points.push_back(vertex_point(2, 1, "face", 0, 7));      // 2.1 already on the skin...
+  set.points.push_back(free_point(2, 1, 0, 0, 0, 8));          // ...so this one stays free
+  ASSERT_TRUE(afmb::bind_fdps(set, scene));
+  const afmb::FreeFdpAttachment a = afmb::attach_free_fdps(set, scene, 0.05);
+  EXPECT_EQ(a.attached, 5);
+  auto on = [&](size_t k, int part, int vertex) {
+    EXPECT_EQ(set.points[k].part, part) << set.points[k].id.str();
+    EXPECT_EQ(set.points[k].vertex, vertex) << set.points[k].id.str();
+    if (part >= 0) {
+      EXPECT_EQ(set.points[k].part_name, scene.parts[static_cast<size_t>(part)].name);
+      EXPECT_EQ(set.points[k].pos, scene.parts[static_cast<size_t>(part)].V.row(vertex).transpose())
+          << "an attached point takes its vertex's own position";
+    }
+  };
+  on(0, 0, 2);
+  on(1, 0, 1);
+  on(2, 0, 5);
+  on(3, 1, 0);
+  on(4, -1, -1);
+  on(5, 0, 3);
+  on(7, -1, -1);
+  ASSERT_EQ(a.free.size(), 2u);
+  EXPECT_EQ(a.free[0]->id.str(), "7.1");
+  EXPECT_EQ(a.free[1]->id.str(), "2.1");
+  EXPECT_NEAR(a.farthest, 0.01, 1e-12);  // the pupil, in front of its eye's vertex
+  ASSERT_TRUE(a.at);
+  EXPECT_EQ(a.at->id.str(), "3.5");
+  // Beyond the tolerance nothing is attached, and a scene without kinds
+  // offers every part: the pupil then takes the nearest vertex, the skin's.
+  FdpSet far;
+  far.points.push_back(free_point(2, 2, 1, 0, 0.2, 1));
+  EXPECT_EQ(afmb::attach_free_fdps(far, scene, 0.1).attached, 0);
+  Scene plain = scene;
+  for (afmb::Part &p : plain.parts) p.kind = afmb::PartKind::Other;
+  FdpSet pupil;
+  pupil.points.push_back(free_point(3, 5, 3, 3, 1, 1));
+  EXPECT_EQ(afmb::attach_free_fdps(pupil, plain, 0.05).attached, 1);
+  EXPECT_EQ(pupil.points[0].part, 0);
+  EXPECT_EQ(pupil.points[0].vertex, 5);
+}
+
 // ---- XfaceEd files: the real song.fdp and alice.fdp ------------------------------
 
 TEST(FdpXfaceEd, SongFdpHas53EntriesOn45FdpsAsTheReferenceLists) {

@@ -40,6 +40,30 @@ grep -v '^3\.6[[:space:]]' "$tmp/head.fdp" >"$tmp/no-36.fdp"
 expect_error "FDP missing for FAPU" 1 "ES0.*3\.6" "$tmp/a.afm" -- \
   "$bin/afm-import" "$tmp/head.obj" "$tmp/no-36.fdp" -o "$tmp/a.afm"
 
+# --- FDPs as coordinates (formats/fdp.md, free points): each lands on the
+# vertex the part + vertex file names, and a chin off the mesh is refused
+# with its line and distance.
+awk 'NR == FNR { if ($1 == "o") { part = $2; n = 0 } else if ($1 == "v") { xyz[part, n++] = $2 " " $3 " " $4 }; next }
+     /^[0-9]+\.[0-9]+[[:space:]]/ && NF == 3 { print $1, xyz[$2, $3]; next } { print }' \
+  "$tmp/head.obj" "$tmp/head.fdp" | sed 's/+//g' >"$tmp/coords.fdp"
+grep -q '^2\.1 [-0-9.e]* [-0-9.e]* [-0-9.e]*$' "$tmp/coords.fdp" || fail "coords.fdp: no coordinates: $(head -6 "$tmp/coords.fdp")"
+"$bin/afm-import" "$tmp/head.obj" "$tmp/coords.fdp" -o "$tmp/coords.afm" >"$tmp/coords.txt" 2>&1 ||
+  fail "afm-import with FDP coordinates failed: $(cat "$tmp/coords.txt")"
+grep -q "FDPs: 83 free points attached.*; free, off the mesh: 7\.1$" "$tmp/coords.txt" || fail "no attachment line: $(cat "$tmp/coords.txt")"
+"$bin/afm-info" --fdps "$tmp/head.afm" | grep 'vertex [0-9]' >"$tmp/fdps_vertex.txt"
+"$bin/afm-info" --fdps "$tmp/coords.afm" | grep 'vertex [0-9]' >"$tmp/fdps_coords.txt"
+[ "$(wc -l <"$tmp/fdps_vertex.txt")" -eq 83 ] || fail "the generated head's AFM lists $(wc -l <"$tmp/fdps_vertex.txt") FDPs"
+cmp -s "$tmp/fdps_vertex.txt" "$tmp/fdps_coords.txt" ||
+  fail "FDP coordinates land elsewhere than their vertices: $(diff "$tmp/fdps_vertex.txt" "$tmp/fdps_coords.txt" | head -5)"
+# (In a mesh whose parts' names say nothing, only the FDPs find the skin.)
+sed 's/^o skin$/o surface/' "$tmp/head.obj" >"$tmp/unnamed.obj"
+"$bin/afm-import" "$tmp/unnamed.obj" "$tmp/coords.fdp" -o "$tmp/unnamed.afm" >"$tmp/unnamed.txt" 2>&1 ||
+  fail "afm-import of a mesh with an unnamed skin and FDP coordinates failed: $(cat "$tmp/unnamed.txt")"
+line=$(grep -n '^2\.1 ' "$tmp/coords.fdp" | cut -d: -f1)
+awk -v n="$line" 'NR == n { $4 = $4 + 0.05 } { print }' "$tmp/coords.fdp" >"$tmp/chin-off.fdp"
+expect_error "free chin off the mesh" 1 "chin-off\.fdp:$line: FDP 2\.1 \(chin\) is a free point 0\.0[0-9]* model units from the nearest vertex" "$tmp/a.afm" -- \
+  "$bin/afm-import" "$tmp/unnamed.obj" "$tmp/chin-off.fdp" -o "$tmp/a.afm"
+
 # --- wrong orientation: named, with the fix
 awk '/^v / { print "v", $2, -$4, $3; next } { print }' "$tmp/head.obj" >"$tmp/zup.obj"
 expect_error "z-up mesh" 1 "--orient" "$tmp/a.afm" -- \
