@@ -123,13 +123,16 @@ NearestVertex nearest_on(const Scene &scene, const Eigen::Vector3d &pos, const s
   return best;
 }
 
-// +1 for an FDP on the upper lip or an upper lid, -1 on the lower ones, 0
-// elsewhere. In a closed mouth the inner contours' points coincide (2.2 and
-// 2.3 are two vertices at one position), so coordinates alone cannot say
-// which lip a point is on.
+// +1 for an FDP on the upper lip, an upper lid or the upper teeth, -1 on the
+// lower ones, 0 elsewhere. In a closed mouth the inner contours' points
+// coincide (2.2 and 2.3 are two vertices at one position), as do the
+// incisors' edges where the teeth touch, so coordinates alone cannot say
+// which side a point is on.
 int vertical_side(FdpId id) {
-  static const FdpId up[] = {{2, 2}, {2, 6}, {2, 7}, {8, 1}, {8, 5}, {8, 6}, {8, 9}, {8, 10}, {3, 1}, {3, 2}, {3, 13}, {3, 14}};
-  static const FdpId down[] = {{2, 3}, {2, 8}, {2, 9}, {8, 2}, {8, 7}, {8, 8}, {3, 3}, {3, 4}, {3, 9}, {3, 10}};
+  static const FdpId up[] = {{2, 2}, {2, 6}, {2, 7},  {8, 1},  {8, 5},  {8, 6}, {8, 9},
+                             {8, 10}, {3, 1}, {3, 2}, {3, 13}, {3, 14}, {9, 8}, {9, 10}};
+  static const FdpId down[] = {{2, 3}, {2, 8}, {2, 9}, {8, 2}, {8, 7}, {8, 8},
+                               {3, 3}, {3, 4}, {3, 9}, {3, 10}, {9, 9}, {9, 11}};
   for (const FdpId &u : up)
     if (u == id) return 1;
   for (const FdpId &d : down)

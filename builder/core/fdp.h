@@ -77,10 +77,10 @@ Status bind_fdps(FdpSet &fdps, const Scene &scene);
 // (fdp_part_kind(): the pupils on the eyes, 6.x on the tongue, the incisors
 // on the teeth, every other FDP on the skin) when the scene's parts are
 // named so (guess_part_kinds), else of every part; the nearest within
-// `tolerance` (model units) wins. Among vertices at one position, the lips'
-// and lids' points take the one on their side (2.2 the one whose triangles
-// lie above, 2.3 below: a closed mouth's inner contours coincide), others
-// the lowest index (an exporter's split seam). The point
+// `tolerance` (model units) wins. Among vertices at one position, the lips',
+// lids' and incisors' points take the one on their side (2.2 the one whose
+// triangles lie above, 2.3 below: a closed mouth's inner contours coincide,
+// as do touching teeth), others the lowest index (an exporter's split seam). The point
 // then gets that part, its name and vertex, and the vertex's own position.
 // Points farther from every candidate stay free: FDP 7.1, the top of the
 // spine, lies inside the neck. A free point whose FDP the set already has on

@@ -2,7 +2,11 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
+#include <map>
 #include <numeric>
+
+#include "core/part_kind.h"
 
 namespace afmb {
 
@@ -54,6 +58,152 @@ int repair_coincident_vertices(Scene &scene, int part_index, std::vector<std::st
                    " zero-area triangles (input triangles" + dropped + ")");
   }
   return removed;
+}
+
+int split_skin_pieces(Scene &scene, int part_index, FdpSet &fdps, std::vector<std::string> *log) {
+  const Part whole = scene.parts[static_cast<size_t>(part_index)];
+  const Eigen::Index nv = whole.V.rows(), nf = whole.F.rows();
+  if (nf == 0 || whole.F.minCoeff() < 0 || whole.F.maxCoeff() >= nv) return 0;  // check_skin says what is wrong
+  std::vector<int> up(static_cast<size_t>(nv));
+  std::iota(up.begin(), up.end(), 0);
+  auto root = [&](int v) {
+    while (up[static_cast<size_t>(v)] != v) v = up[static_cast<size_t>(v)] = up[static_cast<size_t>(up[static_cast<size_t>(v)])];
+    return v;
+  };
+  auto join = [&](int a, int b) {
+    a = root(a), b = root(b);
+    if (a != b) up[static_cast<size_t>(std::max(a, b))] = std::min(a, b);
+  };
+  std::vector<char> used(static_cast<size_t>(nv), 0);
+  for (Eigen::Index f = 0; f < nf; ++f)
+    for (int k = 0; k < 3; ++k) {
+      used[static_cast<size_t>(whole.F(f, k))] = 1;
+      if (k) join(whole.F(f, 0), whole.F(f, k));
+    }
+  // Split seams: vertices at one position on the pieces' open edges. (Closed
+  // pieces that touch, as teeth rows at rest, stay apart.)
+  std::map<std::pair<int, int>, int> edges;  // undirected edge -> triangles using it
+  for (Eigen::Index f = 0; f < nf; ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = whole.F(f, k), b = whole.F(f, (k + 1) % 3);
+      ++edges[{std::min(a, b), std::max(a, b)}];
+    }
+  std::vector<char> open(static_cast<size_t>(nv), 0);
+  for (const auto &[e, n] : edges)
+    if (n == 1) open[static_cast<size_t>(e.first)] = open[static_cast<size_t>(e.second)] = 1;
+  std::map<std::array<double, 3>, int> at;
+  for (Eigen::Index v = 0; v < nv; ++v) {
+    if (!open[static_cast<size_t>(v)]) continue;
+    const auto [it, fresh] = at.insert({{whole.V(v, 0), whole.V(v, 1), whole.V(v, 2)}, static_cast<int>(v)});
+    if (!fresh) join(it->second, static_cast<int>(v));
+  }
+  // Pieces in the order of their first triangle.
+  std::vector<int> piece_of_root(static_cast<size_t>(nv), -1), face_piece(static_cast<size_t>(nf));
+  int pieces = 0;
+  for (Eigen::Index f = 0; f < nf; ++f) {
+    int &p = piece_of_root[static_cast<size_t>(root(whole.F(f, 0)))];
+    if (p < 0) p = pieces++;
+    face_piece[static_cast<size_t>(f)] = p;
+  }
+  const FdpPoint *chin = nullptr;
+  for (const FdpPoint &q : fdps.points)
+    if (q.part == part_index && q.id == FdpId{2, 1} && q.vertex >= 0 && used[static_cast<size_t>(q.vertex)]) chin = &q;
+  if (pieces < 2 || !chin) return 0;
+  auto piece_of_vertex = [&](int v) { return used[static_cast<size_t>(v)] ? piece_of_root[static_cast<size_t>(root(v))] : -1; };
+  const int skin_piece = piece_of_vertex(chin->vertex);
+  // Each piece's vertices, ascending; the skin piece keeps the unreferenced ones.
+  std::vector<std::vector<int>> verts(static_cast<size_t>(pieces));
+  std::vector<int> local(static_cast<size_t>(nv));
+  for (Eigen::Index v = 0; v < nv; ++v) {
+    const int p = piece_of_vertex(static_cast<int>(v));
+    std::vector<int> &list = verts[static_cast<size_t>(p < 0 ? skin_piece : p)];
+    local[static_cast<size_t>(v)] = static_cast<int>(list.size());
+    list.push_back(static_cast<int>(v));
+  }
+  // The kind each piece's FDPs give it.
+  std::vector<PartKind> kind(static_cast<size_t>(pieces), PartKind::Other);
+  std::vector<char> mixed(static_cast<size_t>(pieces), 0);
+  for (const FdpPoint &q : fdps.points) {
+    if (q.part != part_index || q.vertex < 0) continue;
+    const int p = piece_of_vertex(q.vertex);
+    const PartKind k = fdp_part_kind(q.id);
+    if (p < 0 || p == skin_piece || k == PartKind::Skin) continue;
+    if (kind[static_cast<size_t>(p)] != PartKind::Other && kind[static_cast<size_t>(p)] != k)
+      mixed[static_cast<size_t>(p)] = 1;
+    kind[static_cast<size_t>(p)] = k;
+  }
+  for (int p = 0; p < pieces; ++p)
+    if (mixed[static_cast<size_t>(p)]) kind[static_cast<size_t>(p)] = PartKind::Other;  // FDPs of two kinds
+  const bool has_ftc = whole.FTC.rows() == nf && nf > 0 && whole.TC.rows() > 0;
+  const bool has_c = whole.C.rows() == nv && nv > 0;
+  std::vector<int> part_of_piece(static_cast<size_t>(pieces));
+  std::string said;
+  int unnamed = 1;
+  for (int p = 0; p < pieces; ++p) {
+    Part out;
+    if (p == skin_piece) {
+      out = whole;
+    } else {
+      out.kind = kind[static_cast<size_t>(p)];
+      out.name = whole.name + (out.kind != PartKind::Other ? std::string("_") + part_kind_name(out.kind)
+                                                           : "_piece" + std::to_string(++unnamed));
+      while (scene.find_part(out.name) >= 0) out.name += "_";
+      out.diffuse = whole.diffuse;
+      out.texture = whole.texture;
+    }
+    const std::vector<int> &vs = verts[static_cast<size_t>(p)];
+    out.V.resize(static_cast<Eigen::Index>(vs.size()), 3);
+    if (has_c) out.C.resize(static_cast<Eigen::Index>(vs.size()), 3);
+    for (size_t i = 0; i < vs.size(); ++i) {
+      out.V.row(static_cast<Eigen::Index>(i)) = whole.V.row(vs[i]);
+      if (has_c) out.C.row(static_cast<Eigen::Index>(i)) = whole.C.row(vs[i]);
+    }
+    std::vector<Eigen::Index> faces;
+    for (Eigen::Index f = 0; f < nf; ++f)
+      if (face_piece[static_cast<size_t>(f)] == p) faces.push_back(f);
+    out.F.resize(static_cast<Eigen::Index>(faces.size()), 3);
+    std::map<int, int> tc;  // the piece's texture coordinates, in first-use order
+    if (has_ftc) out.FTC.resize(static_cast<Eigen::Index>(faces.size()), 3);
+    for (size_t i = 0; i < faces.size(); ++i)
+      for (int k = 0; k < 3; ++k) {
+        out.F(static_cast<Eigen::Index>(i), k) = local[static_cast<size_t>(whole.F(faces[i], k))];
+        if (has_ftc) {
+          const auto [it, fresh] = tc.insert({whole.FTC(faces[i], k), static_cast<int>(tc.size())});
+          out.FTC(static_cast<Eigen::Index>(i), k) = it->second;
+        }
+      }
+    if (has_ftc) {
+      out.TC.resize(static_cast<Eigen::Index>(tc.size()), 2);
+      for (const auto &[from, to] : tc) out.TC.row(to) = whole.TC.row(from);
+    } else if (whole.TC.rows() == nv && nv > 0) {  // per-vertex texture coordinates
+      out.TC.resize(static_cast<Eigen::Index>(vs.size()), 2);
+      for (size_t i = 0; i < vs.size(); ++i) out.TC.row(static_cast<Eigen::Index>(i)) = whole.TC.row(vs[i]);
+    } else {
+      out.TC.resize(0, 2);
+      out.FTC.resize(0, 3);
+    }
+    if (!has_c) out.C.resize(0, 3);
+    if (p == skin_piece) {
+      part_of_piece[static_cast<size_t>(p)] = part_index;
+      scene.parts[static_cast<size_t>(part_index)] = std::move(out);
+    } else {
+      part_of_piece[static_cast<size_t>(p)] = static_cast<int>(scene.parts.size());
+      said += ", '" + out.name + "' (" + std::to_string(out.V.rows()) + " vertices)";
+      scene.parts.push_back(std::move(out));
+    }
+  }
+  for (FdpPoint &q : fdps.points) {
+    if (q.part != part_index || q.vertex < 0) continue;
+    const int p = piece_of_vertex(q.vertex);
+    q.part = part_of_piece[static_cast<size_t>(p < 0 ? skin_piece : p)];
+    q.part_name = scene.parts[static_cast<size_t>(q.part)].name;
+    q.vertex = local[static_cast<size_t>(q.vertex)];
+  }
+  if (log)
+    log->push_back("part '" + whole.name + "': split into its " + std::to_string(pieces) +
+                   " separate pieces: the skin (" + std::to_string(scene.parts[static_cast<size_t>(part_index)].V.rows()) +
+                   " vertices)" + said);
+  return pieces - 1;
 }
 
 }  // namespace afmb

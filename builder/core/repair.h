@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "core/fdp.h"
 #include "core/scene.h"
 
 namespace afmb {
@@ -16,5 +17,23 @@ namespace afmb {
 // corners, non-manifold edges) is left for check_skin() to refuse. Appends one
 // line per repair to `log`; returns the number of triangles dropped.
 int repair_coincident_vertices(Scene &scene, int part, std::vector<std::string> *log);
+
+// A skin part made of several pieces (a mesh exported as one object, its
+// eyeballs, teeth and tongue inside the head's) is split into one part per
+// piece, so that only the face's surface is simulated and the rest follows
+// what it belongs to. Pieces are connected by shared triangles' corners and
+// by vertices at bit-identical positions on open edges (a seam an exporter
+// split stays one piece; closed pieces that touch, as teeth rows, do not
+// join). The piece holding the part's FDP 2.1 keeps the part's name, kind,
+// material and its unreferenced vertices; each other piece becomes a new part
+// after it, named `<part>_<kind>` by the FDPs it holds (fdp_part_kind: 3.5
+// eye_left, 3.6 eye_right, 6.x tongue, 9.8/9.10 teeth_upper, 9.9/9.11
+// teeth_lower) with that kind, or `<part>_piece<N>` (N from 2, kind Other:
+// it follows the head) when it holds none or FDPs of two kinds. Vertices keep their order within
+// a piece; colours and texture corners go with them. The FDPs on the part
+// are moved to their piece's part and vertex. Appends one line to `log`
+// naming the pieces; returns how many parts were added (0: one piece, or no
+// 2.1 on the part).
+int split_skin_pieces(Scene &scene, int part, FdpSet &fdps, std::vector<std::string> *log);
 
 }  // namespace afmb

@@ -31,7 +31,8 @@ struct LoadedFace {
 constexpr double kFreeFdpShare = 0.005;
 
 // Reads the mesh and the FDPs, binds them, applies or checks the
-// orientation, attaches free FDPs that lie on the mesh, assigns part kinds, repairs coincident skin vertices and
+// orientation, attaches free FDPs that lie on the mesh, assigns part kinds,
+// splits a skin made of several pieces into a part per piece, repairs coincident skin vertices and
 // checks the skin. `log` gets one line per thing done on the user's behalf
 // ("orientation: applied x,z,-y", "FDPs: 84 free points attached ...",
 // "repaired: ..."). Errors name the file and

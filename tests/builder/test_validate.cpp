@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "../common/test_paths.h"
+#include "core/repair.h"
 #include "core/validate.h"
 #include "io/mesh_io.h"
 #include "io/vrml.h"
@@ -43,6 +44,98 @@ Scene grid(int nx = 3, int ny = 3) {
 void add_triangle(Part &p, int a, int b, int c) {
   p.F.conservativeResize(p.F.rows() + 1, 3);
   p.F.row(p.F.rows() - 1) << a, b, c;
+}
+
+// A closed tetrahedron at `o`, outward-facing, appended to p (4 vertices).
+void add_tetrahedron(Part &p, const Eigen::Vector3d &o) {
+  const int b = static_cast<int>(p.V.rows());
+  p.V.conservativeResize(b + 4, 3);
+  p.V.row(b) = o.transpose();
+  p.V.row(b + 1) = (o + Eigen::Vector3d(1, 0, 0)).transpose();
+  p.V.row(b + 2) = (o + Eigen::Vector3d(0, 1, 0)).transpose();
+  p.V.row(b + 3) = (o + Eigen::Vector3d(0, 0, 1)).transpose();
+  add_triangle(p, b, b + 2, b + 1);
+  add_triangle(p, b, b + 1, b + 3);
+  add_triangle(p, b, b + 3, b + 2);
+  add_triangle(p, b + 1, b + 2, b + 3);
+}
+
+afmb::FdpPoint on(const char *id, const std::string &part, int part_index, int vertex) {
+  afmb::FdpPoint q;
+  q.id = *afmb::FdpId::parse(id);
+  q.part_name = part;
+  q.part = part_index;
+  q.vertex = vertex;
+  return q;
+}
+
+// A mesh exported as one object: a face (a 3 x 3 grid cut along x = 1 into
+// two pieces that an exporter split, the cut's vertices doubled), an eye and
+// teeth inside (tetrahedra; the teeth touch the eye at one corner) and a
+// loose piece no FDP names.
+TEST(SplitSkinPieces, GivesEachPieceItsPartAndKeepsSeamsAndFdps) {
+  Scene s = grid(3, 3);
+  Part &p = s.parts[0];
+  p.name = "head";
+  // The seam: triangles of column 0 use copies of the vertices at x = 1.
+  const int n0 = static_cast<int>(p.V.rows());
+  p.V.conservativeResize(n0 + 4, 3);
+  for (int j = 0; j <= 3; ++j) p.V.row(n0 + j) = p.V.row(1 + 4 * j);
+  for (Eigen::Index f = 0; f < p.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int v = p.F(f, k), col = v % 4;
+      bool column0 = true;
+      for (int c = 0; c < 3; ++c) column0 = column0 && p.F(f, c) % 4 <= 1 && p.F(f, c) < n0;
+      if (column0 && col == 1) p.F(f, k) = n0 + v / 4;
+    }
+  const Eigen::Index grid_faces = p.F.rows();
+  add_tetrahedron(p, Eigen::Vector3d(1, 1, -3));   // the eye: vertices n0 + 4 ...
+  add_tetrahedron(p, Eigen::Vector3d(1, 1, -2));   // teeth: their first corner is the eye's top
+  add_tetrahedron(p, Eigen::Vector3d(5, 5, -5));   // a loose piece
+  p.C = Eigen::MatrixXd::Zero(p.V.rows(), 3);
+  for (Eigen::Index v = 0; v < p.V.rows(); ++v) p.C(v, 0) = static_cast<double>(v) / 100;
+  afmb::FdpSet fdps;
+  fdps.points = {on("2.1", "head", 0, 5), on("3.5", "head", 0, n0 + 4 + 1), on("9.9", "head", 0, n0 + 8 + 2),
+                 on("9.11", "head", 0, n0 + 8 + 3), on("2.2", "head", 0, n0 + 1)};
+  const Part before = p;
+  std::vector<std::string> log;
+  ASSERT_EQ(afmb::split_skin_pieces(s, 0, fdps, &log), 3);
+  ASSERT_EQ(s.parts.size(), 4u);
+  const Part &skin = s.parts[0];
+  EXPECT_EQ(skin.name, "head");
+  EXPECT_EQ(skin.F.rows(), grid_faces) << "the seam keeps the face one piece";
+  EXPECT_EQ(skin.V.rows(), n0 + 4);
+  EXPECT_TRUE(afmb::check_skin(s, 0));
+  EXPECT_EQ(s.parts[1].name, "head_eye_left");
+  EXPECT_EQ(s.parts[1].kind, afmb::PartKind::EyeLeft);
+  EXPECT_EQ(s.parts[2].name, "head_teeth_lower") << "touching the eye, closed teeth stay apart";
+  EXPECT_EQ(s.parts[2].kind, afmb::PartKind::TeethLower);
+  EXPECT_EQ(s.parts[3].name, "head_piece2");
+  EXPECT_EQ(s.parts[3].kind, afmb::PartKind::Other);
+  for (size_t i = 1; i < 4; ++i) {
+    EXPECT_EQ(s.parts[i].V.rows(), 4);
+    EXPECT_EQ(s.parts[i].F.rows(), 4);
+  }
+  // Every FDP is where it was, on its piece, and so are the colours.
+  for (const afmb::FdpPoint &q : fdps.points) {
+    ASSERT_GE(q.part, 0);
+    const Part &to = s.parts[static_cast<size_t>(q.part)];
+    EXPECT_EQ(q.part_name, to.name);
+    const int was = q.id.str() == "2.1" ? 5 : q.id.str() == "3.5" ? n0 + 5 : q.id.str() == "9.9" ? n0 + 10
+                                              : q.id.str() == "9.11" ? n0 + 11 : n0 + 1;
+    EXPECT_EQ(to.V.row(q.vertex), before.V.row(was)) << q.id.str();
+    EXPECT_EQ(to.C.row(q.vertex), before.C.row(was)) << q.id.str();
+  }
+  EXPECT_EQ(fdps.points[1].part, 1);
+  EXPECT_EQ(fdps.points[2].part, 2);
+  ASSERT_EQ(log.size(), 1u);
+  EXPECT_NE(log[0].find("split into its 4 separate pieces"), std::string::npos) << log[0];
+  // One piece, or no chin on the part: nothing to do.
+  Scene one = grid(2, 2);
+  afmb::FdpSet chin;
+  chin.points = {on("2.1", "skin", 0, 0)};
+  EXPECT_EQ(afmb::split_skin_pieces(one, 0, chin, nullptr), 0);
+  EXPECT_EQ(afmb::split_skin_pieces(s, 1, fdps, nullptr), 0);
 }
 
 TEST(Validate, SongHeadFailsOnlyOnItsCoincidentCornerTriangles) {

@@ -55,6 +55,19 @@ grep -q "FDPs: 83 free points attached.*; free, off the mesh: 7\.1$" "$tmp/coord
 [ "$(wc -l <"$tmp/fdps_vertex.txt")" -eq 83 ] || fail "the generated head's AFM lists $(wc -l <"$tmp/fdps_vertex.txt") FDPs"
 cmp -s "$tmp/fdps_vertex.txt" "$tmp/fdps_coords.txt" ||
   fail "FDP coordinates land elsewhere than their vertices: $(diff "$tmp/fdps_vertex.txt" "$tmp/fdps_coords.txt" | head -5)"
+# One object for the whole head (eyes, teeth and tongue inside the skin's
+# group): split into its pieces, each found by its FDPs, the FDPs where they were.
+grep -v '^o ' "$tmp/head.obj" >"$tmp/merged.obj"
+"$bin/afm-import" "$tmp/merged.obj" "$tmp/coords.fdp" -o "$tmp/merged.afm" >"$tmp/merged.txt" 2>&1 ||
+  fail "afm-import of a one-object head failed: $(cat "$tmp/merged.txt")"
+grep -q "split into its 6 separate pieces" "$tmp/merged.txt" || fail "no split: $(head -4 "$tmp/merged.txt")"
+for k in eye_left eye_right teeth_upper teeth_lower tongue; do
+  grep -Eq "^  merged_$k +$k " "$tmp/merged.txt" || fail "no $k piece: $(cat "$tmp/merged.txt")"
+done
+"$bin/afm-info" --fdps "$tmp/merged.afm" | grep 'vertex [0-9]' | sed 's/vertex [0-9]*//' | tr -s ' ' >"$tmp/fdps_merged.txt"
+sed 's/vertex [0-9]*//' "$tmp/fdps_vertex.txt" | tr -s ' ' >"$tmp/fdps_places.txt"
+cmp -s "$tmp/fdps_places.txt" "$tmp/fdps_merged.txt" ||
+  fail "the one-object head's FDPs moved: $(diff "$tmp/fdps_places.txt" "$tmp/fdps_merged.txt" | head -5)"
 # (In a mesh whose parts' names say nothing, only the FDPs find the skin.)
 sed 's/^o skin$/o surface/' "$tmp/head.obj" >"$tmp/unnamed.obj"
 "$bin/afm-import" "$tmp/unnamed.obj" "$tmp/coords.fdp" -o "$tmp/unnamed.afm" >"$tmp/unnamed.txt" 2>&1 ||
@@ -84,12 +97,15 @@ awk -v tri="f $a $a $b" '/^o skin/ { s = 1 } s && /^f / && !done { print tri; do
   "$tmp/head.obj" >"$tmp/repeated.obj"
 expect_error "repeated corner" 1 "repeated\.obj:[0-9]+:.*twice" "$tmp/a.afm" -- \
   "$bin/afm-import" "$tmp/repeated.obj" "$tmp/head.fdp" -o "$tmp/a.afm"
-# Three new collinear vertices and a zero-area triangle on them, in the skin.
+# A zero-area triangle in the skin: a skin vertex and two new ones in line
+# with it. (On new vertices alone it would be a piece of its own, which the
+# import splits off the skin.)
 nv=$(grep -c '^v ' "$tmp/head.obj")
-awk -v n="$nv" '/^o skin/ { s = 1 }
-  s && /^f / && !done { print "f", n + 1, n + 2, n + 3; done = 1 }
+at=$(awk -v a="$a" '/^v / && ++n == a { print $2, $3, $4 }' "$tmp/head.obj")
+awk -v n="$nv" -v a="$a" -v at="$at" '/^o skin/ { s = 1 }
+  s && /^f / && !done { print "f", a, n + 1, n + 2; done = 1 }
   { print }
-  END { print "v 0 0 0.5"; print "v 0 0.001 0.5"; print "v 0 0.002 0.5" }' \
+  END { split(at, p, " "); print "v", p[1], p[2] + 0.001, p[3]; print "v", p[1], p[2] + 0.002, p[3] }' \
   "$tmp/head.obj" >"$tmp/degenerate.obj"
 expect_error "degenerate skin" 1 "skin.*degenerate" "$tmp/a.afm" -- \
   "$bin/afm-import" "$tmp/degenerate.obj" "$tmp/head.fdp" -o "$tmp/a.afm"
