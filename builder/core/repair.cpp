@@ -3,8 +3,11 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
+#include <limits>
 #include <map>
 #include <numeric>
+#include <queue>
+#include <set>
 
 #include "core/part_kind.h"
 
@@ -204,6 +207,126 @@ int split_skin_pieces(Scene &scene, int part_index, FdpSet &fdps, std::vector<st
                    " separate pieces: the skin (" + std::to_string(scene.parts[static_cast<size_t>(part_index)].V.rows()) +
                    " vertices)" + said);
   return pieces - 1;
+}
+
+int cut_fused_lips(Scene &scene, int part_index, FdpSet &fdps, std::vector<std::string> *log) {
+  Part &p = scene.parts[static_cast<size_t>(part_index)];
+  const int nv = static_cast<int>(p.V.rows());
+  const Eigen::Index nf = p.F.rows();
+  if (nf == 0 || p.F.minCoeff() < 0 || p.F.maxCoeff() >= nv) return 0;
+  auto vertex_of = [&](const char *id) {
+    const FdpPoint *q = fdps.find(*FdpId::parse(id), part_index);
+    return q && q->part == part_index ? q->vertex : -1;
+  };
+  const int upper = vertex_of("2.2"), lower = vertex_of("2.3");
+  if (upper < 0 || upper != lower) return 0;
+  std::vector<int> stops;
+  for (const char *id : {"2.4", "2.6", "2.2", "2.7", "2.5"}) {
+    const int v = vertex_of(id);
+    if (v < 0) return 0;
+    stops.push_back(v);
+  }
+  // Edges and the triangles about each vertex; an edge in one triangle is the skin's edge.
+  std::map<std::pair<int, int>, int> edge_faces;
+  std::vector<std::vector<int>> faces_at(static_cast<size_t>(nv)), next(static_cast<size_t>(nv));
+  for (Eigen::Index f = 0; f < nf; ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = p.F(f, k), b = p.F(f, (k + 1) % 3);
+      if (++edge_faces[{std::min(a, b), std::max(a, b)}] == 1) {
+        next[static_cast<size_t>(a)].push_back(b);
+        next[static_cast<size_t>(b)].push_back(a);
+      }
+      faces_at[static_cast<size_t>(a)].push_back(static_cast<int>(f));
+    }
+  auto inner_edge = [&](int a, int b) { return edge_faces[{std::min(a, b), std::max(a, b)}] == 2; };
+  // Shortest paths between the stops over inner edges (Dijkstra).
+  std::vector<int> line = {stops[0]};
+  for (size_t s = 1; s < stops.size(); ++s) {
+    const int from = stops[s - 1], to = stops[s];
+    if (from == to) continue;
+    std::vector<double> dist(static_cast<size_t>(nv), std::numeric_limits<double>::infinity());
+    std::vector<int> back(static_cast<size_t>(nv), -1);
+    using Item = std::pair<double, int>;
+    std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+    dist[static_cast<size_t>(from)] = 0;
+    queue.push({0, from});
+    while (!queue.empty()) {
+      const auto [d, v] = queue.top();
+      queue.pop();
+      if (d > dist[static_cast<size_t>(v)] || v == to) continue;
+      for (int w : next[static_cast<size_t>(v)]) {
+        if (!inner_edge(v, w)) continue;
+        const double dw = d + (p.V.row(v) - p.V.row(w)).norm();
+        if (dw < dist[static_cast<size_t>(w)]) dist[static_cast<size_t>(w)] = dw, back[static_cast<size_t>(w)] = v, queue.push({dw, w});
+      }
+    }
+    if (back[static_cast<size_t>(to)] < 0) return 0;
+    std::vector<int> leg;
+    for (int v = to; v != from; v = back[static_cast<size_t>(v)]) leg.push_back(v);
+    line.insert(line.end(), leg.rbegin(), leg.rend());
+  }
+  if (line.size() < 3 || std::set<int>(line.begin(), line.end()).size() != line.size()) return 0;
+  // Each inner vertex of the line: its triangles fall into two fans, split
+  // by the line's two edges; the lower fan (by its corners' mean height)
+  // takes the copy.
+  std::vector<std::pair<int, int>> copies;  // (vertex, copy)
+  std::vector<std::vector<int>> lower_fans;
+  for (size_t i = 1; i + 1 < line.size(); ++i) {
+    const int v = line[i], a = line[i - 1], b = line[i + 1];
+    const std::vector<int> &fan = faces_at[static_cast<size_t>(v)];
+    std::vector<int> side(fan.size(), -1);
+    int sides = 0;
+    for (size_t start = 0; start < fan.size(); ++start) {
+      if (side[start] >= 0) continue;
+      side[start] = sides;
+      for (bool grew = true; grew;) {  // join triangles sharing an edge at v that is not the line's
+        grew = false;
+        for (size_t x = 0; x < fan.size(); ++x)
+          for (size_t y = 0; y < fan.size(); ++y) {
+            if (side[x] != sides || side[y] >= 0) continue;
+            for (int k = 0; k < 3; ++k) {
+              const int w = p.F(fan[x], k);
+              if (w == v || w == a || w == b) continue;
+              if ((p.F.row(fan[y]).array() == w).any()) side[y] = sides, grew = true;
+            }
+          }
+      }
+      ++sides;
+    }
+    if (sides != 2) return 0;
+    double height[2] = {0, 0}, count[2] = {0, 0};
+    for (size_t x = 0; x < fan.size(); ++x)
+      for (int k = 0; k < 3; ++k) height[side[x]] += p.V(p.F(fan[x], k), 1), count[side[x]] += 1;
+    const int low = height[0] / count[0] < height[1] / count[1] ? 0 : 1;
+    std::vector<int> lower_fan;
+    for (size_t x = 0; x < fan.size(); ++x)
+      if (side[x] == low) lower_fan.push_back(fan[x]);
+    copies.push_back({v, nv + static_cast<int>(copies.size())});
+    lower_fans.push_back(std::move(lower_fan));
+  }
+  const int added = static_cast<int>(copies.size());
+  p.V.conservativeResize(nv + added, 3);
+  const bool has_c = p.C.rows() == nv, has_tc = p.TC.rows() == nv && p.FTC.rows() == 0;
+  if (has_c) p.C.conservativeResize(nv + added, 3);
+  if (has_tc) p.TC.conservativeResize(nv + added, 2);
+  for (size_t i = 0; i < copies.size(); ++i) {
+    const auto [v, c] = copies[i];
+    p.V.row(c) = p.V.row(v);
+    if (has_c) p.C.row(c) = p.C.row(v);
+    if (has_tc) p.TC.row(c) = p.TC.row(v);
+    for (int f : lower_fans[i])
+      for (int k = 0; k < 3; ++k)
+        if (p.F(f, k) == v) p.F(f, k) = c;
+  }
+  for (FdpPoint &q : fdps.points)
+    if (q.part == part_index && (q.id == FdpId{2, 3} || q.id == FdpId{2, 8} || q.id == FdpId{2, 9}))
+      for (const auto &[v, c] : copies)
+        if (q.vertex == v) q.vertex = c;
+  if (log)
+    log->push_back("part '" + p.name + "': the lips are one surface (FDPs 2.2 and 2.3 on vertex " +
+                   std::to_string(upper) + "): cut along the lip line from 2.4 to 2.5 (" + std::to_string(added + 1) +
+                   " edges), its " + std::to_string(added) + " inner vertices doubled, so that the mouth can open");
+  return added;
 }
 
 }  // namespace afmb

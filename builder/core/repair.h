@@ -36,4 +36,20 @@ int repair_coincident_vertices(Scene &scene, int part, std::vector<std::string> 
 // 2.1 on the part).
 int split_skin_pieces(Scene &scene, int part, FdpSet &fdps, std::vector<std::string> *log);
 
+// A closed mouth with no slit (a scan's lips are one surface: FDPs 2.2 and
+// 2.3 on one vertex) cannot open: the jaw would stretch the lips like a
+// membrane. So the skin is cut along the lip line: the shortest path over
+// the skin's edges from the left corner 2.4 through 2.6, 2.2 (= 2.3), 2.7
+// to the right corner 2.5 (each FDP on its upper-lip point where the lower
+// one sits on another vertex). Each vertex inside the path gets a copy at
+// its position, appended to the part (colours and per-vertex texture
+// coordinates copied); the triangles below the line, about each such vertex,
+// take the copy; the corners stay whole, as a slit ends there. 2.3, 2.8 and
+// 2.9 move to the copies where they sat on the line. Leaves the part alone
+// (returns 0) where 2.2 and 2.3 are different vertices, an FDP of the line is
+// missing or off the part, or the line would run along the skin's edge or
+// through one vertex twice; else appends one line to `log` and returns how
+// many vertices were copied.
+int cut_fused_lips(Scene &scene, int part, FdpSet &fdps, std::vector<std::string> *log);
+
 }  // namespace afmb

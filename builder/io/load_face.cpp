@@ -79,6 +79,7 @@ Expected<LoadedFace> load_face(const std::string &mesh_path, const std::string &
   }
   std::vector<std::string> repairs;
   if (split_skin_pieces(face.scene, face.skin, face.fdps, &repairs) > 0) assign_part_kinds(face.scene, face.fdps);
+  cut_fused_lips(face.scene, face.skin, face.fdps, &repairs);
   repair_coincident_vertices(face.scene, face.skin, &repairs);
   if (log)
     for (const std::string &r : repairs) log->push_back("repaired: " + r);

@@ -32,7 +32,8 @@ constexpr double kFreeFdpShare = 0.005;
 
 // Reads the mesh and the FDPs, binds them, applies or checks the
 // orientation, attaches free FDPs that lie on the mesh, assigns part kinds,
-// splits a skin made of several pieces into a part per piece, repairs coincident skin vertices and
+// splits a skin made of several pieces into a part per piece, cuts fused
+// lips apart, repairs coincident skin vertices and
 // checks the skin. `log` gets one line per thing done on the user's behalf
 // ("orientation: applied x,z,-y", "FDPs: 84 free points attached ...",
 // "repaired: ..."). Errors name the file and

@@ -1,6 +1,7 @@
 // check_skin on real skins and on small broken ones.
 #include <gtest/gtest.h>
 
+#include <map>
 #include <set>
 #include <sstream>
 #include <string>
@@ -136,6 +137,60 @@ TEST(SplitSkinPieces, GivesEachPieceItsPartAndKeepsSeamsAndFdps) {
   chin.points = {on("2.1", "skin", 0, 0)};
   EXPECT_EQ(afmb::split_skin_pieces(one, 0, chin, nullptr), 0);
   EXPECT_EQ(afmb::split_skin_pieces(s, 1, fdps, nullptr), 0);
+}
+
+// Lips that are one surface: a 6 x 4 grid whose row y = 2 is the lip line,
+// the corners 2.4 at x = 5 and 2.5 at x = 1, 2.2 and 2.3 on one vertex at x = 3.
+TEST(CutFusedLips, DoublesTheLineBetweenTheCornersAndGivesTheLowerLipTheCopies) {
+  Scene s = grid(6, 4);
+  const auto at = [](int x, int y) { return x + 7 * y; };
+  afmb::FdpSet fdps;
+  const std::pair<const char *, int> points[] = {{"2.4", at(5, 2)}, {"2.6", at(4, 2)}, {"2.8", at(4, 2)},
+                                                 {"2.2", at(3, 2)}, {"2.3", at(3, 2)}, {"2.7", at(2, 2)},
+                                                 {"2.9", at(2, 2)}, {"2.5", at(1, 2)}, {"2.1", at(3, 0)}};
+  for (const auto &[id, v] : points) fdps.points.push_back(on(id, "skin", 0, v));
+  const Part before = s.parts[0];
+  auto open_edges = [](const Part &p) {
+    std::map<std::pair<int, int>, int> n;
+    for (Eigen::Index f = 0; f < p.F.rows(); ++f)
+      for (int k = 0; k < 3; ++k) ++n[{std::min(p.F(f, k), p.F(f, (k + 1) % 3)), std::max(p.F(f, k), p.F(f, (k + 1) % 3))}];
+    int open = 0;
+    for (const auto &e : n) open += e.second == 1;
+    return open;
+  };
+  std::vector<std::string> log;
+  ASSERT_EQ(afmb::cut_fused_lips(s, 0, fdps, &log), 3);
+  const Part &p = s.parts[0];
+  ASSERT_EQ(p.V.rows(), before.V.rows() + 3);
+  EXPECT_TRUE(afmb::check_skin(s, 0));
+  EXPECT_EQ(open_edges(p), open_edges(before) + 8) << "a slit of four edges, two sides";
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(p.V.row(before.V.rows() + i), before.V.row(at(4 - i, 2)));
+  // Below the line every triangle uses the copies, above it the originals.
+  for (Eigen::Index f = 0; f < p.F.rows(); ++f) {
+    double y = 0;
+    for (int k = 0; k < 3; ++k) y += p.V(p.F(f, k), 1) / 3;
+    for (int k = 0; k < 3; ++k) {
+      const int v = p.F(f, k);
+      if (y < 2) {
+        EXPECT_FALSE(v == at(2, 2) || v == at(3, 2) || v == at(4, 2)) << "triangle " << f;
+      } else {
+        EXPECT_LT(v, before.V.rows()) << "triangle " << f;
+      }
+    }
+  }
+  for (const afmb::FdpPoint &q : fdps.points) {
+    const bool lower = q.id.str() == "2.3" || q.id.str() == "2.8" || q.id.str() == "2.9";
+    EXPECT_EQ(q.vertex >= before.V.rows(), lower) << q.id.str();
+  }
+  EXPECT_EQ(p.V.row(fdps.points[4].vertex), p.V.row(fdps.points[3].vertex)) << "2.3 where 2.2 is";
+  ASSERT_EQ(log.size(), 1u);
+  EXPECT_NE(log[0].find("the lips are one surface"), std::string::npos) << log[0];
+  // Lips already apart (2.2 and 2.3 on different vertices): left alone.
+  Scene apart = grid(6, 4);
+  fdps.points[4].vertex = at(3, 1);
+  fdps.points[4].part = 0;
+  EXPECT_EQ(afmb::cut_fused_lips(apart, 0, fdps, nullptr), 0);
+  EXPECT_EQ(apart.parts[0].F, grid(6, 4).parts[0].F);
 }
 
 TEST(Validate, SongHeadFailsOnlyOnItsCoincidentCornerTriangles) {
