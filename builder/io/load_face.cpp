@@ -51,10 +51,15 @@ Expected<LoadedFace> load_face(const std::string &mesh_path, const std::string &
   const FreeFdpAttachment a = attach_free_fdps(face.fdps, face.scene, tolerance);
   if (log && a.attached > 0) {
     char line[160];
-    std::snprintf(line, sizeof line, "%d free points attached to the vertex they lie on (the farthest %.3g model units away: ",
-                  a.attached, a.farthest);
-    std::string l = std::string("FDPs: ") + line + "FDP " + a.at->id.str() + " on part '" + a.at->part_name +
-                    "', vertex " + std::to_string(a.at->vertex) + ")";
+    std::snprintf(line, sizeof line, "%d free points attached to the vertex they lie on (", a.attached);
+    std::string l = std::string("FDPs: ") + line;
+    if (a.farthest > 0) {
+      std::snprintf(line, sizeof line, "the farthest %.3g model units away: ", a.farthest);
+      l += line + std::string("FDP ") + a.at->id.str() + " on part '" + a.at->part_name + "', vertex " +
+           std::to_string(a.at->vertex) + ")";
+    } else {
+      l += "each exactly on it)";
+    }
     if (!a.free.empty()) {
       l += "; free, off the mesh:";
       for (const FdpPoint *p : a.free) l += " " + p->id.str();

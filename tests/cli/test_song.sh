@@ -37,6 +37,25 @@ for f in "43  *shift_tongue_tip" "47  *tongue_roll"; do
 done
 [ -s "$tmp/report/sheet.png" ] && [ -s "$tmp/report/index.html" ] || fail "Song: no fidelity report"
 
+# Song's FDPs as coordinates (one per FDP, as the visage form holds them):
+# each lands where the XfaceEd file puts it, on the same part. (Its tongue
+# has seams an exporter split: there the vertex may be another copy.)
+fdps_on_parts() {  # FDP, part, position of each FDP of AFM $1 (the first point of each)
+  "$bin/afm-info" "$1" | awk '/^  part  / { t = 1; next }
+    t && $2 ~ /^[a-z_]+$/ && $3 ~ /^[0-9]+$/ && $4 ~ /^[0-9]+$/ { total += $3; print $1, total; next } { t = 0 }' >"$tmp/parts.txt"
+  "$bin/afm-info" --fdps "$1" | grep 'vertex [0-9]' | awk 'BEGIN { n = 0 } NR == FNR { name[n] = $1; end[n] = $2 + 0; ++n; next }
+    !seen[$1]++ { p = ""; for (i = n - 1; i >= 0; --i) if ($3 + 0 < end[i]) p = name[i]; print $1, p, $4, $5, $6 }' "$tmp/parts.txt" -
+}
+fdps_on_parts "$tmp/song.afm" >"$tmp/fdps_xfaceed.txt"
+awk '{ x = $3 " " $4 " " $5; gsub(/[()+]/, "", x); print $1, x }' "$tmp/fdps_xfaceed.txt" >"$tmp/coords.fdp"
+"$bin/afm-import" "$song/song.WRL" "$tmp/coords.fdp" --flip-v -o "$tmp/coords.afm" >"$tmp/coords.txt" 2>&1 ||
+  fail "Song with FDP coordinates: $(head -n 3 "$tmp/coords.txt")"
+grep -q "^FDPs: $(grep -c . "$tmp/coords.fdp") free points attached" "$tmp/coords.txt" || fail "Song's coordinates not attached: $(head -n 2 "$tmp/coords.txt")"
+fdps_on_parts "$tmp/coords.afm" >"$tmp/fdps_coords.txt"
+[ "$(grep -c ' song_eyeball_left ' "$tmp/fdps_coords.txt")" -eq 1 ] || fail "no FDP on Song's left eyeball: $(cat "$tmp/fdps_coords.txt")"
+cmp -s "$tmp/fdps_xfaceed.txt" "$tmp/fdps_coords.txt" ||
+  fail "Song's FDP coordinates land elsewhere: $(diff "$tmp/fdps_xfaceed.txt" "$tmp/fdps_coords.txt" | head -n 4)"
+
 "$bin/afm-play" "$tmp/song.afm" "$stream" >"$tmp/play.txt" 2>&1 || fail "afm-play failed on Song: $(tail -n 3 "$tmp/play.txt")"
 # A line per frame with its pose hash: the face must move, so the hashes vary.
 hashes=$(awk '$1 == "frame" { print $NF }' "$tmp/play.txt" | sort -u | wc -l)
