@@ -56,6 +56,9 @@ struct Scene {
   std::string units;   // "m", "cm", "mm" or "" when the source does not say
   std::string source;  // path the scene was read from, for messages
   std::vector<Part> parts;
+  // What the reader passed over and the user should hear of (an OBJ's
+  // material library that is missing), one line each; the import logs them.
+  std::vector<std::string> notes;
 
   // Index of the part whose name or alias is `name`, or -1.
   int find_part(std::string_view name) const;

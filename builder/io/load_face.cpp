@@ -29,6 +29,8 @@ Expected<LoadedFace> load_face(const std::string &mesh_path, const std::string &
   Expected<Scene> scene = read_scene(mesh_path);
   if (!scene) return scene.status();
   face.scene = std::move(*scene);
+  if (log)
+    for (const std::string &n : face.scene.notes) log->push_back("note: " + n);
   if (options.flip_v)
     for (Part &p : face.scene.parts)
       if (p.TC.rows()) p.TC.col(1) = (1.0 - p.TC.col(1).array()).matrix();

@@ -18,6 +18,7 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <unordered_map>
@@ -139,6 +140,7 @@ bool parse_int(std::string_view s, long *out) {
 struct ObjFace {
   int line = 0;
   int group = 0;
+  int material = -1;    // index into ObjScan::materials (the last usemtl), -1 for none
   std::vector<int> v;   // 0-based vertex indices as written (relative ones resolved)
   std::vector<int> vt;  // 0-based texture indices, or empty when the face has none
 };
@@ -155,6 +157,8 @@ struct ObjScan {
   std::vector<std::string> groups;  // first appearance order; "" = faces before any o/g
   std::vector<Eigen::Vector2d> vt;
   int nv = 0;
+  std::vector<std::string> materials;  // usemtl names, first use order
+  std::vector<std::pair<std::string, int>> libraries;  // mtllib file names as written, with their line
 };
 
 bool parse_double(std::string_view s, double *out) {
@@ -165,8 +169,8 @@ bool parse_double(std::string_view s, double *out) {
 
 Expected<ObjScan> scan_obj(const std::string &text, const std::string &path) {
   ObjScan s;
-  std::map<std::string, int> group_index;
-  int group = -1;
+  std::map<std::string, int> group_index, material_index;
+  int group = -1, material = -1;
   auto use_group = [&](const std::string &name) {
     auto it = group_index.find(name);
     if (it != group_index.end()) return it->second;
@@ -221,11 +225,19 @@ Expected<ObjScan> scan_obj(const std::string &text, const std::string &path) {
       s.vt.push_back(t);
     } else if (key == "o" || key == "g") {
       group = use_group(std::string(trim(line.substr(1))));
+    } else if (key == "usemtl") {
+      const std::string name(trim(line.substr(6)));
+      const auto [it, fresh] = material_index.insert({name, static_cast<int>(s.materials.size())});
+      if (fresh) s.materials.push_back(name);
+      material = it->second;
+    } else if (key == "mtllib") {
+      for (size_t k = 1; k < w.size(); ++k) s.libraries.push_back({std::string(w[k]), line_no});
     } else if (key == "f") {
       if (group < 0) group = use_group("");
       ObjFace f;
       f.line = line_no;
       f.group = group;
+      f.material = material;
       if (w.size() < 4)
         return err("face with " + std::to_string(w.size() - 1) + " vertices (at least 3 needed)");
       const long nvt = static_cast<long>(s.vt.size());
@@ -376,6 +388,56 @@ Status read_obj_group(const std::string &text, const std::string &path, const Ob
   return Status::ok();
 }
 
+// What an OBJ part takes from its material: Kd and map_Kd.
+struct ObjMaterial {
+  std::optional<Eigen::Vector3d> kd;
+  std::string map_kd;  // the image file as the library names it, or ""
+};
+
+// The materials of one MTL file (newmtl, Kd, map_Kd; the rest is passed
+// over). map_Kd's options (-s 1 1 1, -clamp on, ...) come before the file
+// name, which may hold spaces.
+Status read_mtl(const std::string &path, std::map<std::string, ObjMaterial> &out) {
+  Expected<std::string> text = read_file(path);
+  if (!text) return text.status();
+  ObjMaterial *m = nullptr;
+  size_t pos = 0;
+  int line_no = 0;
+  while (pos < text->size()) {
+    size_t nl = text->find('\n', pos);
+    if (nl == std::string::npos) nl = text->size();
+    ++line_no;
+    const std::string_view line = trim(std::string_view(*text).substr(pos, nl - pos));
+    pos = nl + 1;
+    const std::vector<std::string_view> w = words(line);
+    if (w.empty() || w[0][0] == '#') continue;
+    auto err = [&](const std::string &msg) { return Status::error(path + ":" + std::to_string(line_no) + ": " + msg); };
+    if (w[0] == "newmtl") {
+      m = &out[std::string(trim(line.substr(6)))];
+    } else if (w[0] == "Kd" && m) {
+      Eigen::Vector3d c;
+      for (int k = 0; k < 3; ++k)
+        if (w.size() < 4 || !parse_double(w[static_cast<size_t>(k) + 1], &c[k]))
+          return err("Kd needs three numbers, found '" + std::string(line) + "'");
+      m->kd = c.cwiseMax(0.0).cwiseMin(1.0);
+    } else if (w[0] == "map_Kd" && m) {
+      static const std::map<std::string_view, int> kArgs = {
+          {"-blendu", 1}, {"-blendv", 1}, {"-bm", 1}, {"-boost", 1}, {"-cc", 1}, {"-clamp", 1}, {"-imfchan", 1},
+          {"-mm", 2},     {"-o", 3},      {"-s", 3},  {"-t", 3},     {"-texres", 1}};
+      size_t k = 1;
+      while (k < w.size() && kArgs.count(w[k])) {
+        const int n = kArgs.at(w[k]);
+        ++k;
+        double x = 0;
+        for (int a = 0; a < n && k < w.size() && (n == 1 || parse_double(w[k], &x)); ++a) ++k;
+      }
+      if (k >= w.size()) return err("map_Kd names no file");
+      m->map_kd = std::string(line.substr(static_cast<size_t>(w[k].data() - line.data())));
+    }
+  }
+  return Status::ok();
+}
+
 Expected<Scene> read_obj(const std::string &path) {
   Expected<std::string> text = read_file(path);
   if (!text) return text.status();
@@ -389,6 +451,7 @@ Expected<Scene> read_obj(const std::string &path) {
   for (const ObjFace &f : scan->faces) ++group_faces[f.group];
   const bool single =
       std::count_if(group_faces.begin(), group_faces.end(), [](int n) { return n > 0; }) == 1;
+  std::vector<int> part_group;  // the group each part was read from
   for (int g = 0; g < static_cast<int>(scan->groups.size()); ++g) {
     if (group_faces[g] == 0) continue;  // e.g. an `o` line directly followed by a `g` line
     Part part;
@@ -398,7 +461,42 @@ Expected<Scene> read_obj(const std::string &path) {
     if (Status st = read_obj_group(*text, path, *scan, g, single, part); !st) return st;
     part.kind = guess_part_kind(part);
     scene.parts.push_back(std::move(part));
+    part_group.push_back(g);
   }
+  // Materials: each part takes the one most of its faces use (the first
+  // used of those tied).
+  std::map<std::string, ObjMaterial> materials;
+  bool all_found = true;
+  for (const auto &[lib, line] : scan->libraries) {
+    const std::string file = (std::filesystem::path(path).parent_path() / lib).string();
+    std::error_code ec;
+    if (!std::filesystem::exists(file, ec)) {
+      scene.notes.push_back(path + ":" + std::to_string(line) + ": material library '" + lib +
+                            "' not found: the parts keep the default colour, without textures");
+      all_found = false;
+      continue;
+    }
+    if (Status st = read_mtl(file, materials); !st) return st;
+  }
+  std::set<std::string> unknown;
+  for (size_t i = 0; i < scene.parts.size(); ++i) {
+    std::vector<int> uses(scan->materials.size(), 0);
+    for (const ObjFace &f : scan->faces)
+      if (f.group == part_group[i] && f.material >= 0) ++uses[static_cast<size_t>(f.material)];
+    const auto most = std::max_element(uses.begin(), uses.end());
+    if (most == uses.end() || *most == 0) continue;
+    const std::string &name = scan->materials[static_cast<size_t>(most - uses.begin())];
+    const auto it = materials.find(name);
+    if (it == materials.end()) {
+      unknown.insert(name);
+      continue;
+    }
+    if (it->second.kd) scene.parts[i].diffuse = *it->second.kd;
+    scene.parts[i].texture = it->second.map_kd;
+  }
+  for (const std::string &name : unknown)
+    if (all_found)
+      scene.notes.push_back(path + ": material '" + name + "' is in no material library: the default colour");
   return scene;
 }
 

@@ -17,7 +17,12 @@ namespace afmb {
 //                the group has them. With one part it keeps every vertex in
 //                file order, so vertex i is the file's `v` number i+1; with
 //                several, each part keeps the vertices its faces use, in file
-//                order. Materials (mtllib/usemtl) are not read.
+//                order. Materials: each part takes the `usemtl` most of its
+//                faces use, from the `mtllib` files beside the OBJ: `Kd`
+//                becomes its diffuse colour, `map_Kd` its texture (the file
+//                name as written, options such as `-s 1 1 1` left out); a
+//                missing library or material is a note (Scene::notes), a
+//                malformed `Kd` an error naming the MTL file and line.
 //   .ply .off .stl  OpenMesh, one part named after the file stem; PLY/OFF
 //                vertex colours become C and vertex texcoords TC (FTC = F).
 //   .wrl .vrml   read_vrml().

@@ -106,6 +106,40 @@ TEST(MeshIo, ObjGroupsBecomePartsWithTexcoords) {
   EXPECT_EQ(b.TC.rows(), 0);
 }
 
+TEST(MeshIo, ObjMaterialsGiveEachPartItsColourAndTexture) {
+  const std::string dir = afmtest::temp_dir("mesh_io_mtl");
+  const std::string path = dir + "/m.obj";
+  write_text(dir + "/m.mtl",
+             "# two materials\nnewmtl skin\nNs 10\nKd 0.8 0.6 0.5\nmap_Kd -s 1 1 1 -clamp on face map.png\n"
+             "newmtl eye\nKd 2 0.5 -1\n");
+  write_text(path,
+             "mtllib m.mtl\n"
+             "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\n"
+             "g face\nusemtl skin\nf 1 2 3\nf 1 3 4\nusemtl eye\nf 2 5 3\n"
+             "g eye_l\nusemtl eye\nf 1 2 4\n"
+             "g other\nusemtl none\nf 2 3 4\n");
+  auto s = afmb::read_scene(path);
+  ASSERT_TRUE(s) << s.status().message();
+  ASSERT_EQ(s->parts.size(), 3u);
+  EXPECT_EQ(s->parts[0].texture, "face map.png") << "the most used material; options left out, spaces kept";
+  EXPECT_EQ(s->parts[0].diffuse, Eigen::Vector3d(0.8, 0.6, 0.5));
+  EXPECT_EQ(s->parts[1].texture, "");
+  EXPECT_EQ(s->parts[1].diffuse, Eigen::Vector3d(1, 0.5, 0)) << "Kd held to 0..1";
+  EXPECT_EQ(s->parts[2].diffuse, afmb::Part().diffuse);
+  ASSERT_EQ(s->notes.size(), 1u);
+  EXPECT_NE(s->notes[0].find("material 'none' is in no material library"), std::string::npos) << s->notes[0];
+  // A missing library is a note, with the OBJ's line; a malformed Kd an error with the MTL's.
+  write_text(dir + "/n.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nmtllib gone.mtl\nusemtl skin\nf 1 2 3\n");
+  auto n = afmb::read_scene(dir + "/n.obj");
+  ASSERT_TRUE(n) << n.status().message();
+  ASSERT_EQ(n->notes.size(), 1u);
+  EXPECT_NE(n->notes[0].find("n.obj:4: material library 'gone.mtl' not found"), std::string::npos) << n->notes[0];
+  write_text(dir + "/m.mtl", "newmtl skin\nKd 0.8 x 0.5\n");
+  auto bad = afmb::read_scene(path);
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.status().message().find("m.mtl:2: Kd needs three numbers"), std::string::npos) << bad.status().message();
+}
+
 TEST(MeshIo, SongObjRoundTrip) {
   AFM_REQUIRE_SHARED_DATA();
   auto a = afmb::read_scene(afmtest::shared_data("faces/song/song.WRL"));

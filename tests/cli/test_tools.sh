@@ -77,6 +77,19 @@ awk -v n="$line" 'NR == n { $4 = $4 + 0.05 } { print }' "$tmp/coords.fdp" >"$tmp
 expect_error "free chin off the mesh" 1 "chin-off\.fdp:$line: FDP 2\.1 \(chin\) is a free point 0\.0[0-9]* model units from the nearest vertex" "$tmp/a.afm" -- \
   "$bin/afm-import" "$tmp/unnamed.obj" "$tmp/chin-off.fdp" -o "$tmp/a.afm"
 
+# --- OBJ materials: the skin's map_Kd becomes its texture in the AFM.
+awk '/^o skin$/ { print "mtllib head.mtl"; print; print "usemtl face"; next } { print }' "$tmp/head.obj" >"$tmp/textured.obj"
+printf 'newmtl face\nKd 0.9 0.7 0.6\nmap_Kd -s 1 1 1 face.png\n' >"$tmp/head.mtl"
+"$bin/afm-import" "$tmp/textured.obj" "$tmp/head.fdp" -o "$tmp/textured.afm" >"$tmp/textured.txt" 2>&1 ||
+  fail "afm-import of an OBJ with a material failed: $(cat "$tmp/textured.txt")"
+"$bin/afm-info" "$tmp/textured.afm" | grep -Eq '^  skin +skin +[0-9]+ +[0-9]+ +face\.png$' ||
+  fail "the skin's map_Kd is not its texture: $("$bin/afm-info" "$tmp/textured.afm" | grep -A3 '  part  ')"
+rm "$tmp/head.mtl"
+"$bin/afm-import" "$tmp/textured.obj" "$tmp/head.fdp" -o "$tmp/textured.afm" >"$tmp/textured.txt" 2>&1 ||
+  fail "afm-import of an OBJ without its material library failed: $(cat "$tmp/textured.txt")"
+grep -q "^note: .*textured\.obj:[0-9]*: material library 'head\.mtl' not found" "$tmp/textured.txt" ||
+  fail "no note of the missing material library: $(head -n 3 "$tmp/textured.txt")"
+
 # --- wrong orientation: named, with the fix
 awk '/^v / { print "v", $2, -$4, $3; next } { print }' "$tmp/head.obj" >"$tmp/zup.obj"
 expect_error "z-up mesh" 1 "--orient" "$tmp/a.afm" -- \
