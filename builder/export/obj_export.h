@@ -4,7 +4,10 @@
 // order, texture coordinates when the AFM has them) with the target fully
 // applied, i.e. at its reference value. Rigid parts stay neutral. Positions
 // are written to position_decimals(step) places, so a target's file minus
-// neutral.obj gives its deltas back exactly (in quanta).
+// neutral.obj gives its deltas back exactly (in quanta). Every file uses
+// DIR/materials.mtl: a material per part, named as the part, with its colour
+// and texture (the image's name as the AFM holds it; the images are not
+// copied).
 #pragma once
 
 #include <afm/format.h>
@@ -18,9 +21,11 @@
 
 namespace afmb {
 
+constexpr const char *kObjMaterials = "materials.mtl";
+
 struct ObjExportStats {
-  size_t files = 0;
-  size_t bytes = 0;
+  size_t files = 0;  // OBJ files (the material library besides)
+  size_t bytes = 0;  // of every file, the library's too
 };
 
 // Writes the files into `dir` (created when missing; its parent must

@@ -654,18 +654,44 @@ Expected<Scene> read_scene(const std::string &path) {
   return read_single(path, ext);
 }
 
-Status write_obj(const Scene &scene, const std::string &path) {
+namespace {
+
+// A part's name as a single OBJ/MTL line's rest.
+std::string line_name(const Part &p) {
+  std::string name = p.name.empty() ? std::string("part") : p.name;
+  std::replace(name.begin(), name.end(), '\n', '_');
+  std::replace(name.begin(), name.end(), '\r', '_');
+  return name;
+}
+
+}  // namespace
+
+Status write_mtl(const Scene &scene, const std::string &path) {
+  std::string out = "# materials of " + (scene.name.empty() ? std::string("the scene") : scene.name) + "\n";
+  for (const Part &p : scene.parts) {
+    out += "newmtl " + line_name(p) + "\nKd";
+    for (int k = 0; k < 3; ++k) {
+      out += ' ';
+      put_number(out, p.diffuse[k]);
+    }
+    out += '\n';
+    if (!p.texture.empty()) out += "map_Kd " + p.texture + "\n";
+  }
+  return write_file_atomic(path, out);
+}
+
+Status write_obj(const Scene &scene, const std::string &path, const std::string &mtllib) {
   std::string out;
   out.reserve(64 + scene.vertex_count() * 40 + scene.triangle_count() * 30);
   if (!scene.name.empty()) out += "# " + scene.name + "\n";
+  if (!mtllib.empty()) out += "mtllib " + mtllib + "\n";
   long vbase = 1, tbase = 1;
   for (const Part &p : scene.parts) {
     if (p.V.cols() != 3 || p.F.cols() != 3 || (p.TC.rows() > 0 && p.FTC.rows() != p.F.rows()))
       return Status::error(path + ": part '" + p.name + "' has malformed matrices");
-    std::string name = p.name.empty() ? std::string("part") : p.name;
-    std::replace(name.begin(), name.end(), '\n', '_');
-    std::replace(name.begin(), name.end(), '\r', '_');
+    const std::string name = line_name(p);
     out += "o " + name + "\n";
+    if (!mtllib.empty()) out += "usemtl " + name + "\n";
     for (Eigen::Index i = 0; i < p.V.rows(); ++i) {
       out += "v";
       for (int k = 0; k < 3; ++k) {

@@ -43,8 +43,15 @@ namespace afmb {
 Expected<Scene> read_scene(const std::string &path);
 
 // Writes an OBJ with one `o` per part, `vt`/`f v/vt` when a part has TC,
-// numbers in their shortest exact form. Colours, materials and kinds are not
-// written. Atomic: the file appears complete or not at all.
-Status write_obj(const Scene &scene, const std::string &path);
+// numbers in their shortest exact form. With `mtllib`, that line first and
+// `usemtl <part name>` after each `o` (write_mtl writes the library).
+// Vertex colours and kinds are not written. Atomic: the file appears
+// complete or not at all.
+Status write_obj(const Scene &scene, const std::string &path, const std::string &mtllib = "");
+
+// Writes an MTL library with one material per part, named as the part: `Kd`
+// its diffuse colour, `map_Kd` its texture when it has one (as the part
+// names it). Atomic.
+Status write_mtl(const Scene &scene, const std::string &path);
 
 }  // namespace afmb

@@ -24,6 +24,7 @@
 #include "export/json_writer.h"
 #include "export/obj_export.h"
 #include "export/vrml_export.h"
+#include "io/mesh_io.h"
 #include "io/vrml.h"
 #include "../common/synthetic_doc.h"
 #include "../common/test_paths.h"
@@ -202,6 +203,30 @@ TEST(ExportObj, TargetMinusNeutralIsTheAfmDeltas) {
       for (int c = 0; c < 3; ++c)
         ASSERT_EQ(std::lround((moved[v][c] - neutral[v][c]) / g.step), it == want.end() ? 0 : it->second[c])
             << name << " vertex " << v << " axis " << c;
+    }
+  }
+}
+
+// Every OBJ names materials.mtl; each part's material, named as the part,
+// carries its colour and texture, as the OBJ reader reads them back.
+TEST(ExportObj, MaterialsCarryEachPartsColourAndTexture) {
+  afm_doc doc = reference_doc();  // a shallow copy whose first part gets a texture
+  std::vector<afm_part> parts(doc.geometry.parts, doc.geometry.parts + doc.geometry.part_count);
+  parts[0].texture = "skin map.png";
+  doc.geometry.parts = parts.data();
+  const std::string dir = afmtest::temp_dir("export_obj_mtl") + "/obj";
+  ASSERT_TRUE(afmb::export_obj(doc, dir));
+  EXPECT_TRUE(fs::exists(dir + "/materials.mtl"));
+  for (const char *file : {"/neutral.obj", "/open_jaw.obj"}) {
+    afmb::Expected<afmb::Scene> back = afmb::read_scene(dir + file);
+    ASSERT_TRUE(back) << back.status().message();
+    EXPECT_TRUE(back->notes.empty()) << back->notes[0];
+    ASSERT_EQ(back->parts.size(), size_t(doc.geometry.part_count));
+    for (uint32_t i = 0; i < doc.geometry.part_count; ++i) {
+      const afmb::Part &p = back->parts[i];
+      EXPECT_EQ(p.name, parts[i].name);
+      EXPECT_EQ(p.texture, parts[i].texture) << p.name;
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(p.diffuse[c], parts[i].diffuse[c] / 255.0, 1e-4) << p.name;
     }
   }
 }
