@@ -137,6 +137,33 @@ int split_skin_pieces(Scene &scene, int part_index, FdpSet &fdps, std::vector<st
   }
   for (int p = 0; p < pieces; ++p)
     if (mixed[static_cast<size_t>(p)]) kind[static_cast<size_t>(p)] = PartKind::Other;  // FDPs of two kinds
+  // A piece no FDP names that lies in the mouth, behind the lips (teeth,
+  // gums, a tongue: Song's and Alice's files name no teeth), moves with the
+  // bone on its side of the lip line: above it the skull's (TeethUpper),
+  // below it the jaw's (TeethLower).
+  const FdpPoint *lip = nullptr, *corner_l = nullptr, *corner_r = nullptr;
+  for (const FdpPoint &q : fdps.points)
+    if (q.part == part_index && q.vertex >= 0) {
+      if (q.id == FdpId{2, 2}) lip = &q;
+      if (q.id == FdpId{2, 4}) corner_l = &q;
+      if (q.id == FdpId{2, 5}) corner_r = &q;
+    }
+  if (lip && corner_l && corner_r) {
+    const double w = corner_l->pos.x() - corner_r->pos.x(), drop = lip->pos.y() - chin->pos.y();
+    std::vector<Eigen::Vector3d> sum(static_cast<size_t>(pieces), Eigen::Vector3d::Zero());
+    std::vector<int> count(static_cast<size_t>(pieces), 0);
+    for (Eigen::Index v = 0; v < nv; ++v)
+      if (const int p = piece_of_vertex(static_cast<int>(v)); p >= 0)
+        sum[static_cast<size_t>(p)] += whole.V.row(v).transpose(), ++count[static_cast<size_t>(p)];
+    for (int p = 0; p < pieces; ++p) {
+      if (p == skin_piece || kind[static_cast<size_t>(p)] != PartKind::Other || mixed[static_cast<size_t>(p)]) continue;
+      const Eigen::Vector3d c = sum[static_cast<size_t>(p)] / count[static_cast<size_t>(p)];
+      const bool in_mouth = w > 0 && drop > 0 && c.x() > corner_r->pos.x() - w / 4 && c.x() < corner_l->pos.x() + w / 4 &&
+                            c.y() > chin->pos.y() && c.y() < lip->pos.y() + drop && c.z() < lip->pos.z() &&
+                            c.z() > lip->pos.z() - 1.5 * w;
+      if (in_mouth) kind[static_cast<size_t>(p)] = c.y() > lip->pos.y() ? PartKind::TeethUpper : PartKind::TeethLower;
+    }
+  }
   const bool has_ftc = whole.FTC.rows() == nf && nf > 0 && whole.TC.rows() > 0;
   const bool has_c = whole.C.rows() == nv && nv > 0;
   std::vector<int> part_of_piece(static_cast<size_t>(pieces));
@@ -150,7 +177,8 @@ int split_skin_pieces(Scene &scene, int part_index, FdpSet &fdps, std::vector<st
       out.kind = kind[static_cast<size_t>(p)];
       out.name = whole.name + (out.kind != PartKind::Other ? std::string("_") + part_kind_name(out.kind)
                                                            : "_piece" + std::to_string(++unnamed));
-      while (scene.find_part(out.name) >= 0) out.name += "_";
+      for (int k = 2; scene.find_part(out.name) >= 0; ++k)
+        out.name = whole.name + "_" + part_kind_name(out.kind) + "_" + std::to_string(k);
       out.diffuse = whole.diffuse;
       out.texture = whole.texture;
     }

@@ -28,8 +28,12 @@ int repair_coincident_vertices(Scene &scene, int part, std::vector<std::string> 
 // material and its unreferenced vertices; each other piece becomes a new part
 // after it, named `<part>_<kind>` by the FDPs it holds (fdp_part_kind: 3.5
 // eye_left, 3.6 eye_right, 6.x tongue, 9.8/9.10 teeth_upper, 9.9/9.11
-// teeth_lower) with that kind, or `<part>_piece<N>` (N from 2, kind Other:
-// it follows the head) when it holds none or FDPs of two kinds. Vertices keep their order within
+// teeth_lower) with that kind; a piece holding none whose centre lies in
+// the mouth (within a quarter of the mouth's width beyond its corners 2.4,
+// 2.5, between the chin 2.1 and as far above the lip line 2.2, behind 2.2 by
+// up to 1.5 mouth widths) is teeth_upper above the lip line and teeth_lower
+// below it (teeth, gums or a tongue: each then moves with its bone); the
+// rest `<part>_piece<N>` (N from 2, kind Other: it follows the head). Vertices keep their order within
 // a piece; colours and texture corners go with them. The FDPs on the part
 // are moved to their piece's part and vertex. Appends one line to `log`
 // naming the pieces; returns how many parts were added (0: one piece, or no
