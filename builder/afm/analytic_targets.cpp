@@ -144,7 +144,6 @@ Expected<AnalyticModel> make_analytic_model(const Scene &scene, const FdpSet &fd
   // The jaw: a hinge between the ears, level with the lower ear contacts.
   const FdpPoint *chin = fdp_on(2, 1, skin), *lower_lip = fdp_on(2, 3, skin);
   const FdpPoint *jl = fdp_pos(2, 13), *jr = fdp_pos(2, 14), *el = fdp_pos(10, 7), *er = fdp_pos(10, 8);
-  const int teeth_lower = scene.find_kind(PartKind::TeethLower), tongue = scene.find_kind(PartKind::Tongue);
   const FdpPoint *eye_l = fdp_pos(3, 5), *eye_r = fdp_pos(3, 6);
   if (chin && lower_lip && ((jl && jr) || (eye_l && eye_r))) {
     Eigen::Vector3d pivot;
@@ -192,8 +191,9 @@ Expected<AnalyticModel> make_analytic_model(const Scene &scene, const FdpSet &fd
     RigidPart jaw;
     jaw.kind = AFM_RIGID_JAW;
     jaw.pivot = pivot;
-    if (teeth_lower >= 0) jaw.parts.push_back(teeth_lower);
-    if (tongue >= 0) jaw.parts.push_back(tongue);
+    for (PartKind k : {PartKind::TeethLower, PartKind::Tongue})
+      for (size_t p = 0; p < scene.parts.size(); ++p)
+        if (scene.parts[p].kind == k) jaw.parts.push_back(static_cast<int>(p));
     jaw.controls.push_back({3, AFM_DOF_ROTATE_X, angle / ref3 / 1e-5});
     jaw.controls.push_back({14, AFM_DOF_TRANSLATE_Z, fapu.mns0 / 1024.0});
     jaw.controls.push_back({15, AFM_DOF_TRANSLATE_X, -fapu.mw0 / 1024.0});

@@ -72,11 +72,13 @@ cmp -s "$tmp/fdps_places.txt" "$tmp/fdps_merged.txt" ||
 # in the mouth still move with their bone: above the lip line the skull's,
 # below it the jaw's.
 grep -v '^9\.\(8\|9\|10\|11\) \|^6\.' "$tmp/coords.fdp" >"$tmp/no-teeth.fdp"
-"$bin/afm-import" "$tmp/merged.obj" "$tmp/no-teeth.fdp" -o "$tmp/merged2.afm" >"$tmp/merged2.txt" 2>&1 ||
+"$bin/afm-import" "$tmp/merged.obj" "$tmp/no-teeth.fdp" -o "$tmp/merged2.afm" --analytic >"$tmp/merged2.txt" 2>&1 ||
   fail "afm-import of a one-object head without teeth FDPs failed: $(cat "$tmp/merged2.txt")"
 for k in teeth_upper:teeth_upper teeth_lower:teeth_lower teeth_lower_2:teeth_lower; do
   grep -Eq "^  merged_${k%%:*} +${k##*:} " "$tmp/merged2.txt" || fail "no ${k%%:*} piece without FDPs: $(grep -A8 '  part  ' "$tmp/merged2.txt")"
 done
+"$bin/afm-info" "$tmp/merged2.afm" | grep -q "^  jaw .* moves merged_teeth_lower merged_teeth_lower_2;" ||
+  fail "the jaw does not carry both pieces below the lip line: $("$bin/afm-info" "$tmp/merged2.afm" | grep '^  jaw')"
 # (In a mesh whose parts' names say nothing, only the FDPs find the skin.)
 sed 's/^o skin$/o surface/' "$tmp/head.obj" >"$tmp/unnamed.obj"
 "$bin/afm-import" "$tmp/unnamed.obj" "$tmp/coords.fdp" -o "$tmp/unnamed.afm" >"$tmp/unnamed.txt" 2>&1 ||
