@@ -45,6 +45,7 @@ int repair_coincident_vertices(Scene &scene, int part_index, std::vector<std::st
     else
       keep.push_back(f);
   }
+  const Eigen::Index nf_before = part.F.rows();
   const int removed = static_cast<int>(part.F.rows() - static_cast<Eigen::Index>(keep.size()));
   Eigen::MatrixXi F(static_cast<Eigen::Index>(keep.size()), 3), FTC;
   const bool has_ftc = part.FTC.rows() == part.F.rows() && part.FTC.rows() > 0;
@@ -55,6 +56,11 @@ int repair_coincident_vertices(Scene &scene, int part_index, std::vector<std::st
   }
   part.F = F;
   if (has_ftc) part.FTC = FTC;
+  if (part.face_material.size() == static_cast<size_t>(nf_before)) {
+    std::vector<int> fm;
+    for (Eigen::Index f : keep) fm.push_back(part.face_material[static_cast<size_t>(f)]);
+    part.face_material = std::move(fm);
+  }
   if (log) {
     log->push_back("part '" + part.name + "': welded coincident vertices" + welded);
     log->push_back("part '" + part.name + "': dropped " + std::to_string(removed) +
@@ -193,6 +199,22 @@ int split_skin_pieces(Scene &scene, int part_index, FdpSet &fdps, std::vector<st
     for (Eigen::Index f = 0; f < nf; ++f)
       if (face_piece[static_cast<size_t>(f)] == p) faces.push_back(f);
     out.F.resize(static_cast<Eigen::Index>(faces.size()), 3);
+    if (whole.face_material.size() == static_cast<size_t>(nf) && !whole.materials.empty()) {
+      // The piece's own material: the one most of its triangles use.
+      std::vector<int> uses(whole.materials.size(), 0);
+      out.face_material.clear();
+      for (Eigen::Index f : faces) {
+        const int m = whole.face_material[static_cast<size_t>(f)];
+        out.face_material.push_back(m);
+        if (m >= 0) ++uses[static_cast<size_t>(m)];
+      }
+      out.materials = whole.materials;
+      const auto most = std::max_element(uses.begin(), uses.end());
+      if (*most > 0) {
+        out.diffuse = whole.materials[static_cast<size_t>(most - uses.begin())].diffuse;
+        out.texture = whole.materials[static_cast<size_t>(most - uses.begin())].texture;
+      }
+    }
     std::map<int, int> tc;  // the piece's texture coordinates, in first-use order
     if (has_ftc) out.FTC.resize(static_cast<Eigen::Index>(faces.size()), 3);
     for (size_t i = 0; i < faces.size(); ++i)

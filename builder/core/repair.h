@@ -33,9 +33,11 @@ int repair_coincident_vertices(Scene &scene, int part, std::vector<std::string> 
 // 2.5, between the chin 2.1 and as far above the lip line 2.2, behind 2.2 by
 // up to 1.5 mouth widths) is teeth_upper above the lip line and teeth_lower
 // below it (teeth, gums or a tongue: each then moves with its bone); the
-// rest `<part>_piece<N>` (N from 2, kind Other: it follows the head). Vertices keep their order within
-// a piece; colours and texture corners go with them. The FDPs on the part
-// are moved to their piece's part and vertex. Appends one line to `log`
+// rest `<part>_piece<N>` (N from 2, kind Other: it follows the head).
+// Vertices keep their order within a piece; colours and texture corners go
+// with them, and where the part knows its faces' materials (OBJ) each piece
+// takes the one most of its triangles use (the eyes their own texture). The
+// FDPs on the part are moved to their piece's part and vertex. Appends one line to `log`
 // naming the pieces; returns how many parts were added (0: one piece, or no
 // 2.1 on the part).
 int split_skin_pieces(Scene &scene, int part, FdpSet &fdps, std::vector<std::string> *log);

@@ -48,6 +48,18 @@ struct Part {
   Eigen::Vector3d diffuse{0.8, 0.8, 0.8};  // material colour, RGB in [0,1]
   std::string texture;  // image file as named by the source, or empty
 
+  // The faces' own materials where the source gives each face one (OBJ's
+  // usemtl), for splitting the part into pieces (split_skin_pieces): each
+  // piece takes the one most of its faces use. diffuse and texture above
+  // are the part's most used one's. Empty, or #F indices into `materials`
+  // (-1: none).
+  struct Material {
+    Eigen::Vector3d diffuse{0.8, 0.8, 0.8};
+    std::string texture;
+  };
+  std::vector<Material> materials;
+  std::vector<int> face_material;
+
   bool matches(std::string_view name_or_alias) const;
 };
 

@@ -463,8 +463,8 @@ Expected<Scene> read_obj(const std::string &path) {
     scene.parts.push_back(std::move(part));
     part_group.push_back(g);
   }
-  // Materials: each part takes the one most of its faces use (the first
-  // used of those tied).
+  // Materials: each part takes the one most of its triangles use (the first
+  // used of those tied), and keeps each triangle's (Part::face_material).
   std::map<std::string, ObjMaterial> materials;
   bool all_found = true;
   for (const auto &[lib, line] : scan->libraries) {
@@ -480,19 +480,45 @@ Expected<Scene> read_obj(const std::string &path) {
   }
   std::set<std::string> unknown;
   for (size_t i = 0; i < scene.parts.size(); ++i) {
-    std::vector<int> uses(scan->materials.size(), 0);
-    for (const ObjFace &f : scan->faces)
-      if (f.group == part_group[i] && f.material >= 0) ++uses[static_cast<size_t>(f.material)];
-    const auto most = std::max_element(uses.begin(), uses.end());
-    if (most == uses.end() || *most == 0) continue;
-    const std::string &name = scan->materials[static_cast<size_t>(most - uses.begin())];
-    const auto it = materials.find(name);
-    if (it == materials.end()) {
-      unknown.insert(name);
+    Part &part = scene.parts[i];
+    // Each triangle's material (fan triangles share their polygon's), the
+    // library's ones only; the part's own is the most used.
+    std::vector<int> local(scan->materials.size(), -2);  // -2: not looked up yet
+    std::vector<int> uses;
+    for (const ObjFace &f : scan->faces) {
+      if (f.group != part_group[i]) continue;
+      int m = -1;
+      if (f.material >= 0) {
+        int &l = local[static_cast<size_t>(f.material)];
+        if (l == -2) {
+          const std::string &name = scan->materials[static_cast<size_t>(f.material)];
+          const auto it = materials.find(name);
+          if (it == materials.end()) {
+            unknown.insert(name);
+            l = -1;
+          } else {
+            Part::Material pm;
+            if (it->second.kd) pm.diffuse = *it->second.kd;
+            pm.texture = it->second.map_kd;
+            l = static_cast<int>(part.materials.size());
+            part.materials.push_back(pm);
+            uses.push_back(0);
+          }
+        }
+        m = l;
+      }
+      for (size_t c = 1; c + 1 < f.v.size(); ++c) {
+        part.face_material.push_back(m);
+        if (m >= 0) ++uses[static_cast<size_t>(m)];
+      }
+    }
+    if (part.materials.empty()) {
+      part.face_material.clear();
       continue;
     }
-    if (it->second.kd) scene.parts[i].diffuse = *it->second.kd;
-    scene.parts[i].texture = it->second.map_kd;
+    const Part::Material &most = part.materials[static_cast<size_t>(std::max_element(uses.begin(), uses.end()) - uses.begin())];
+    part.diffuse = most.diffuse;
+    part.texture = most.texture;
   }
   for (const std::string &name : unknown)
     if (all_found)

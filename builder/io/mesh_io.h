@@ -18,9 +18,11 @@ namespace afmb {
 //                file order, so vertex i is the file's `v` number i+1; with
 //                several, each part keeps the vertices its faces use, in file
 //                order. Materials: each part takes the `usemtl` most of its
-//                faces use, from the `mtllib` files beside the OBJ: `Kd`
+//                triangles use, from the `mtllib` files beside the OBJ: `Kd`
 //                becomes its diffuse colour, `map_Kd` its texture (the file
-//                name as written, options such as `-s 1 1 1` left out); a
+//                name as written, options such as `-s 1 1 1` left out), and
+//                keeps each triangle's (Part::face_material: a head exported
+//                as one object, split into pieces, gives each its own); a
 //                missing library or material is a note (Scene::notes), a
 //                malformed `Kd` an error naming the MTL file and line.
 //   .ply .off .stl  OpenMesh, one part named after the file stem; PLY/OFF

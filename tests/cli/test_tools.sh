@@ -68,6 +68,15 @@ done
 sed 's/vertex [0-9]*//' "$tmp/fdps_vertex.txt" | tr -s ' ' >"$tmp/fdps_places.txt"
 cmp -s "$tmp/fdps_places.txt" "$tmp/fdps_merged.txt" ||
   fail "the one-object head's FDPs moved: $(diff "$tmp/fdps_places.txt" "$tmp/fdps_merged.txt" | head -5)"
+# One object with a material per piece: each piece keeps its own texture.
+awk 'NR == 1 { print "mtllib parts.mtl" } /^o / { print "usemtl " $2; next } { print }' "$tmp/head.obj" >"$tmp/merged-mtl.obj"
+for m in skin eye_left eye_right teeth_upper teeth_lower tongue; do printf 'newmtl %s\nKd 1 1 1\nmap_Kd %s.png\n' $m $m; done >"$tmp/parts.mtl"
+"$bin/afm-import" "$tmp/merged-mtl.obj" "$tmp/coords.fdp" -o "$tmp/merged-mtl.afm" >"$tmp/merged-mtl.txt" 2>&1 ||
+  fail "afm-import of a one-object head with materials failed: $(cat "$tmp/merged-mtl.txt")"
+for k in :skin _eye_left:eye_left _eye_right:eye_right _teeth_upper:teeth_upper _teeth_lower:teeth_lower _tongue:tongue; do
+  grep -Eq "^  merged-mtl${k%%:*} +[a-z_]+ +[0-9]+ +[0-9]+ +${k##*:}\.png$" "$tmp/merged-mtl.txt" ||
+    fail "piece merged-mtl${k%%:*} lacks its texture ${k##*:}.png: $(grep -A8 '  part  ' "$tmp/merged-mtl.txt")"
+done
 # Without FDPs on the teeth and tongue (Song's file names none), the pieces
 # in the mouth still move with their bone: above the lip line the skull's,
 # below it the jaw's.
