@@ -191,9 +191,7 @@ Expected<AnalyticModel> make_analytic_model(const Scene &scene, const FdpSet &fd
     RigidPart jaw;
     jaw.kind = AFM_RIGID_JAW;
     jaw.pivot = pivot;
-    for (PartKind k : {PartKind::TeethLower, PartKind::Tongue})
-      for (size_t p = 0; p < scene.parts.size(); ++p)
-        if (scene.parts[p].kind == k) jaw.parts.push_back(static_cast<int>(p));
+    jaw.parts = scene.find_kinds({PartKind::TeethLower, PartKind::Tongue});
     jaw.controls.push_back({3, AFM_DOF_ROTATE_X, angle / ref3 / 1e-5});
     jaw.controls.push_back({14, AFM_DOF_TRANSLATE_Z, fapu.mns0 / 1024.0});
     jaw.controls.push_back({15, AFM_DOF_TRANSLATE_X, -fapu.mw0 / 1024.0});

@@ -13,15 +13,46 @@
 
 namespace afmb {
 
+namespace {
+
+// Disjoint sets of indices; each set's root is its lowest index.
+struct Unions {
+  std::vector<int> up;
+  explicit Unions(size_t n) : up(n) { std::iota(up.begin(), up.end(), 0); }
+  int root(int v) {
+    while (up[static_cast<size_t>(v)] != v) v = up[static_cast<size_t>(v)] = up[static_cast<size_t>(up[static_cast<size_t>(v)])];
+    return v;
+  }
+  bool join(int a, int b) {  // false when already one set
+    a = root(a), b = root(b);
+    if (a == b) return false;
+    up[static_cast<size_t>(std::max(a, b))] = std::min(a, b);
+    return true;
+  }
+};
+
+// Every undirected edge of F (lower index first) and how many triangles use it.
+std::map<std::pair<int, int>, int> edge_uses(const Eigen::MatrixXi &F) {
+  std::map<std::pair<int, int>, int> uses;
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = F(f, k), b = F(f, (k + 1) % 3);
+      ++uses[{std::min(a, b), std::max(a, b)}];
+    }
+  return uses;
+}
+
+// Triangles to work on: some, each index a vertex. (check_skin says what is wrong otherwise.)
+bool has_valid_triangles(const Part &p) {
+  return p.F.rows() > 0 && p.F.minCoeff() >= 0 && p.F.maxCoeff() < p.V.rows();
+}
+
+}  // namespace
+
 int repair_coincident_vertices(Scene &scene, int part_index, std::vector<std::string> *log) {
   Part &part = scene.parts[static_cast<size_t>(part_index)];
-  const Eigen::Index nv = part.V.rows();
-  std::vector<int> to(static_cast<size_t>(nv));
-  std::iota(to.begin(), to.end(), 0);
-  auto root = [&](int v) {
-    while (to[static_cast<size_t>(v)] != v) v = to[static_cast<size_t>(v)];
-    return v;
-  };
+  Unions sets(static_cast<size_t>(part.V.rows()));
+  auto root = [&](int v) { return sets.root(v); };
   std::string welded;
   for (Eigen::Index f = 0; f < part.F.rows(); ++f) {
     Eigen::Vector3d a = part.V.row(part.F(f, 0)), b = part.V.row(part.F(f, 1)), c = part.V.row(part.F(f, 2));
@@ -31,7 +62,7 @@ int repair_coincident_vertices(Scene &scene, int part_index, std::vector<std::st
         int p = root(part.F(f, i)), q = root(part.F(f, j));
         if (p == q || part.V.row(p) != part.V.row(q)) continue;
         if (p > q) std::swap(p, q);
-        to[static_cast<size_t>(q)] = p;
+        sets.join(p, q);
         welded += " " + std::to_string(q) + "->" + std::to_string(p);
       }
   }
@@ -72,39 +103,25 @@ int repair_coincident_vertices(Scene &scene, int part_index, std::vector<std::st
 int split_skin_pieces(Scene &scene, int part_index, FdpSet &fdps, std::vector<std::string> *log) {
   const Part whole = scene.parts[static_cast<size_t>(part_index)];
   const Eigen::Index nv = whole.V.rows(), nf = whole.F.rows();
-  if (nf == 0 || whole.F.minCoeff() < 0 || whole.F.maxCoeff() >= nv) return 0;  // check_skin says what is wrong
-  std::vector<int> up(static_cast<size_t>(nv));
-  std::iota(up.begin(), up.end(), 0);
-  auto root = [&](int v) {
-    while (up[static_cast<size_t>(v)] != v) v = up[static_cast<size_t>(v)] = up[static_cast<size_t>(up[static_cast<size_t>(v)])];
-    return v;
-  };
-  auto join = [&](int a, int b) {
-    a = root(a), b = root(b);
-    if (a != b) up[static_cast<size_t>(std::max(a, b))] = std::min(a, b);
-  };
+  if (!has_valid_triangles(whole)) return 0;
+  Unions sets(static_cast<size_t>(nv));
+  auto root = [&](int v) { return sets.root(v); };
   std::vector<char> used(static_cast<size_t>(nv), 0);
   for (Eigen::Index f = 0; f < nf; ++f)
     for (int k = 0; k < 3; ++k) {
       used[static_cast<size_t>(whole.F(f, k))] = 1;
-      if (k) join(whole.F(f, 0), whole.F(f, k));
+      if (k) sets.join(whole.F(f, 0), whole.F(f, k));
     }
   // Split seams: vertices at one position on the pieces' open edges. (Closed
   // pieces that touch, as teeth rows at rest, stay apart.)
-  std::map<std::pair<int, int>, int> edges;  // undirected edge -> triangles using it
-  for (Eigen::Index f = 0; f < nf; ++f)
-    for (int k = 0; k < 3; ++k) {
-      const int a = whole.F(f, k), b = whole.F(f, (k + 1) % 3);
-      ++edges[{std::min(a, b), std::max(a, b)}];
-    }
   std::vector<char> open(static_cast<size_t>(nv), 0);
-  for (const auto &[e, n] : edges)
+  for (const auto &[e, n] : edge_uses(whole.F))
     if (n == 1) open[static_cast<size_t>(e.first)] = open[static_cast<size_t>(e.second)] = 1;
   std::map<std::array<double, 3>, int> at;
   for (Eigen::Index v = 0; v < nv; ++v) {
     if (!open[static_cast<size_t>(v)]) continue;
     const auto [it, fresh] = at.insert({{whole.V(v, 0), whole.V(v, 1), whole.V(v, 2)}, static_cast<int>(v)});
-    if (!fresh) join(it->second, static_cast<int>(v));
+    if (!fresh) sets.join(it->second, static_cast<int>(v));
   }
   // Pieces in the order of their first triangle.
   std::vector<int> piece_of_root(static_cast<size_t>(nv), -1), face_piece(static_cast<size_t>(nf));
@@ -263,7 +280,7 @@ int cut_fused_lips(Scene &scene, int part_index, FdpSet &fdps, std::vector<std::
   Part &p = scene.parts[static_cast<size_t>(part_index)];
   const int nv = static_cast<int>(p.V.rows());
   const Eigen::Index nf = p.F.rows();
-  if (nf == 0 || p.F.minCoeff() < 0 || p.F.maxCoeff() >= nv) return 0;
+  if (!has_valid_triangles(p)) return 0;
   auto vertex_of = [&](const char *id) {
     const FdpPoint *q = fdps.find(*FdpId::parse(id), part_index);
     return q && q->part == part_index ? q->vertex : -1;
@@ -276,19 +293,13 @@ int cut_fused_lips(Scene &scene, int part_index, FdpSet &fdps, std::vector<std::
     if (v < 0) return 0;
     stops.push_back(v);
   }
-  // Edges and the triangles about each vertex; an edge in one triangle is the skin's edge.
-  std::map<std::pair<int, int>, int> edge_faces;
+  // The inner edges (in two triangles; one in a single triangle is the
+  // skin's edge) from each vertex, and the triangles about each vertex.
   std::vector<std::vector<int>> faces_at(static_cast<size_t>(nv)), next(static_cast<size_t>(nv));
+  for (const auto &[e, n] : edge_uses(p.F))
+    if (n == 2) next[static_cast<size_t>(e.first)].push_back(e.second), next[static_cast<size_t>(e.second)].push_back(e.first);
   for (Eigen::Index f = 0; f < nf; ++f)
-    for (int k = 0; k < 3; ++k) {
-      const int a = p.F(f, k), b = p.F(f, (k + 1) % 3);
-      if (++edge_faces[{std::min(a, b), std::max(a, b)}] == 1) {
-        next[static_cast<size_t>(a)].push_back(b);
-        next[static_cast<size_t>(b)].push_back(a);
-      }
-      faces_at[static_cast<size_t>(a)].push_back(static_cast<int>(f));
-    }
-  auto inner_edge = [&](int a, int b) { return edge_faces[{std::min(a, b), std::max(a, b)}] == 2; };
+    for (int k = 0; k < 3; ++k) faces_at[static_cast<size_t>(p.F(f, k))].push_back(static_cast<int>(f));
   // Shortest paths between the stops over inner edges (Dijkstra).
   std::vector<int> line = {stops[0]};
   for (size_t s = 1; s < stops.size(); ++s) {
@@ -305,7 +316,6 @@ int cut_fused_lips(Scene &scene, int part_index, FdpSet &fdps, std::vector<std::
       queue.pop();
       if (d > dist[static_cast<size_t>(v)] || v == to) continue;
       for (int w : next[static_cast<size_t>(v)]) {
-        if (!inner_edge(v, w)) continue;
         const double dw = d + (p.V.row(v) - p.V.row(w)).norm();
         if (dw < dist[static_cast<size_t>(w)]) dist[static_cast<size_t>(w)] = dw, back[static_cast<size_t>(w)] = v, queue.push({dw, w});
       }
@@ -324,26 +334,21 @@ int cut_fused_lips(Scene &scene, int part_index, FdpSet &fdps, std::vector<std::
   for (size_t i = 1; i + 1 < line.size(); ++i) {
     const int v = line[i], a = line[i - 1], b = line[i + 1];
     const std::vector<int> &fan = faces_at[static_cast<size_t>(v)];
-    std::vector<int> side(fan.size(), -1);
-    int sides = 0;
-    for (size_t start = 0; start < fan.size(); ++start) {
-      if (side[start] >= 0) continue;
-      side[start] = sides;
-      for (bool grew = true; grew;) {  // join triangles sharing an edge at v that is not the line's
-        grew = false;
-        for (size_t x = 0; x < fan.size(); ++x)
-          for (size_t y = 0; y < fan.size(); ++y) {
-            if (side[x] != sides || side[y] >= 0) continue;
-            for (int k = 0; k < 3; ++k) {
-              const int w = p.F(fan[x], k);
-              if (w == v || w == a || w == b) continue;
-              if ((p.F.row(fan[y]).array() == w).any()) side[y] = sides, grew = true;
-            }
-          }
+    // Triangles of the fan sharing an edge at v that is not the line's are
+    // on one side.
+    Unions fans(fan.size());
+    int sides = static_cast<int>(fan.size());
+    std::map<int, int> first_at;  // the fan's other corner -> the first triangle holding it
+    for (size_t x = 0; x < fan.size(); ++x)
+      for (int k = 0; k < 3; ++k) {
+        const int w = p.F(fan[x], k);
+        if (w == v || w == a || w == b) continue;
+        const auto [it, fresh] = first_at.insert({w, static_cast<int>(x)});
+        if (!fresh && fans.join(it->second, static_cast<int>(x))) --sides;
       }
-      ++sides;
-    }
     if (sides != 2) return 0;
+    std::vector<int> side(fan.size());
+    for (size_t x = 0; x < fan.size(); ++x) side[x] = fans.root(static_cast<int>(x)) == 0 ? 0 : 1;
     double height[2] = {0, 0}, count[2] = {0, 0};
     for (size_t x = 0; x < fan.size(); ++x)
       for (int k = 0; k < 3; ++k) height[side[x]] += p.V(p.F(fan[x], k), 1), count[side[x]] += 1;

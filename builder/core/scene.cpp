@@ -51,6 +51,14 @@ int Scene::find_kind(PartKind kind) const {
   return -1;
 }
 
+std::vector<int> Scene::find_kinds(std::initializer_list<PartKind> kinds) const {
+  std::vector<int> out;
+  for (PartKind k : kinds)
+    for (size_t i = 0; i < parts.size(); ++i)
+      if (parts[i].kind == k) out.push_back(static_cast<int>(i));
+  return out;
+}
+
 size_t Scene::vertex_count() const {
   size_t n = 0;
   for (const Part &p : parts) n += static_cast<size_t>(p.V.rows());

@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <initializer_list>
 #include <vector>
 
 namespace afmb {
@@ -76,6 +77,9 @@ struct Scene {
   int find_part(std::string_view name) const;
   // Index of the first part of this kind, or -1.
   int find_kind(PartKind kind) const;
+  // Indices of every part of these kinds, kind by kind, each in part order
+  // (the jaw carries {TeethLower, Tongue}: a split head may have several).
+  std::vector<int> find_kinds(std::initializer_list<PartKind> kinds) const;
   size_t vertex_count() const;
   size_t triangle_count() const;
 };

@@ -285,9 +285,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
 
   out.jaw.kind = AFM_RIGID_JAW;
   out.jaw.pivot = model.jaw.pivot;
-  for (PartKind k : {PartKind::TeethLower, PartKind::Tongue})  // every such part: a split head may have several
-    for (size_t p = 0; p < scene.parts.size(); ++p)
-      if (scene.parts[p].kind == k) out.jaw.parts.push_back(static_cast<int>(p));
+  out.jaw.parts = scene.find_kinds({PartKind::TeethLower, PartKind::Tongue});
   // Lashes and lid strips ride on the skin (skin_binding.h).
   out.carried = bind_to_skin(scene, model.skin, PartKind::Eyelid);
   const std::vector<SkinBinding> &carried = out.carried;

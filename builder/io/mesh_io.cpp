@@ -18,7 +18,6 @@
 #include <fstream>
 #include <iostream>
 #include <map>
-#include <optional>
 #include <set>
 #include <sstream>
 #include <unordered_map>
@@ -388,19 +387,13 @@ Status read_obj_group(const std::string &text, const std::string &path, const Ob
   return Status::ok();
 }
 
-// What an OBJ part takes from its material: Kd and map_Kd.
-struct ObjMaterial {
-  std::optional<Eigen::Vector3d> kd;
-  std::string map_kd;  // the image file as the library names it, or ""
-};
-
-// The materials of one MTL file (newmtl, Kd, map_Kd; the rest is passed
-// over). map_Kd's options (-s 1 1 1, -clamp on, ...) come before the file
-// name, which may hold spaces.
-Status read_mtl(const std::string &path, std::map<std::string, ObjMaterial> &out) {
+// The materials of one MTL file (newmtl; Kd the colour, map_Kd the texture;
+// the rest is passed over). map_Kd's options (-s 1 1 1, -clamp on, ...) come
+// before the file name, which may hold spaces.
+Status read_mtl(const std::string &path, std::map<std::string, Part::Material> &out) {
   Expected<std::string> text = read_file(path);
   if (!text) return text.status();
-  ObjMaterial *m = nullptr;
+  Part::Material *m = nullptr;
   size_t pos = 0;
   int line_no = 0;
   while (pos < text->size()) {
@@ -419,7 +412,7 @@ Status read_mtl(const std::string &path, std::map<std::string, ObjMaterial> &out
       for (int k = 0; k < 3; ++k)
         if (w.size() < 4 || !parse_double(w[static_cast<size_t>(k) + 1], &c[k]))
           return err("Kd needs three numbers, found '" + std::string(line) + "'");
-      m->kd = c.cwiseMax(0.0).cwiseMin(1.0);
+      m->diffuse = c.cwiseMax(0.0).cwiseMin(1.0);
     } else if (w[0] == "map_Kd" && m) {
       static const std::map<std::string_view, int> kArgs = {
           {"-blendu", 1}, {"-blendv", 1}, {"-bm", 1}, {"-boost", 1}, {"-cc", 1}, {"-clamp", 1}, {"-imfchan", 1},
@@ -432,7 +425,7 @@ Status read_mtl(const std::string &path, std::map<std::string, ObjMaterial> &out
         for (int a = 0; a < n && k < w.size() && (n == 1 || parse_double(w[k], &x)); ++a) ++k;
       }
       if (k >= w.size()) return err("map_Kd names no file");
-      m->map_kd = std::string(line.substr(static_cast<size_t>(w[k].data() - line.data())));
+      m->texture = std::string(line.substr(static_cast<size_t>(w[k].data() - line.data())));
     }
   }
   return Status::ok();
@@ -465,7 +458,7 @@ Expected<Scene> read_obj(const std::string &path) {
   }
   // Materials: each part takes the one most of its triangles use (the first
   // used of those tied), and keeps each triangle's (Part::face_material).
-  std::map<std::string, ObjMaterial> materials;
+  std::map<std::string, Part::Material> materials;
   bool all_found = true;
   for (const auto &[lib, line] : scan->libraries) {
     const std::string file = (std::filesystem::path(path).parent_path() / lib).string();
@@ -497,11 +490,8 @@ Expected<Scene> read_obj(const std::string &path) {
             unknown.insert(name);
             l = -1;
           } else {
-            Part::Material pm;
-            if (it->second.kd) pm.diffuse = *it->second.kd;
-            pm.texture = it->second.map_kd;
             l = static_cast<int>(part.materials.size());
-            part.materials.push_back(pm);
+            part.materials.push_back(it->second);
             uses.push_back(0);
           }
         }
