@@ -831,8 +831,8 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     auto apply = [&](const Vec &p, Vec &out) { block_multiply(sys, K, p, out); };
     if (factor)
       return filtered_pcg(apply, [&](const Vec &in, Vec &out) { factor->solve(in, out); }, contacts, b, x,
-                          max_cg, options.cg_relative, indefinite);
-    return filtered_pcg(apply, jacobi(diag), contacts, b, x, max_cg, options.cg_relative, indefinite);
+                          max_cg, options.newton_forcing, indefinite);
+    return filtered_pcg(apply, jacobi(diag), contacts, b, x, max_cg, options.newton_forcing, indefinite);
   };
   const int max_it = options.max_iterations > 0 ? options.max_iterations : 400;
   double action = 0;

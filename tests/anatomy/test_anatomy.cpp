@@ -1137,6 +1137,47 @@ TEST(Solver, LongerStepsCutTheCrawlOnAStiffSkin) {
   EXPECT_LT(st[1].iterations, st[0].iterations);
 }
 
+TEST(Solver, InexactNewtonStepsReachTheSameEquilibrium) {
+  // Each Newton step's linear solve stops once CG has cut its residual by
+  // newton_forcing (0.1), not 1e-5: the stopping rule on the positions
+  // decides the result, so both land within the tolerance of the one
+  // equilibrium; the inexact steps need fewer CG iterations. Also under
+  // load control (a calibration's bordered steps): the same tension.
+  const FaceModel &m = head_1k().model;
+  const Muscle &mu = m.muscles[static_cast<size_t>(m.find("zygomaticus_major_left"))];
+  ASSERT_EQ(SolverOptions().newton_forcing, m.solver.newton_forcing);
+  ForceField f = [&](const Eigen::MatrixXd &X, Eigen::MatrixXd *F, NodeBlocks *K) {
+    return muscle_load(m.tissue, mu, 0.5, X, F, K);
+  };
+  LoadControl control[2];
+  Eigen::MatrixXd X[2], Xc[2];
+  SolveStats st[2], sc[2];
+  for (int exact = 0; exact < 2; ++exact) {
+    SolverOptions so = m.solver;
+    if (exact) so.newton_forcing = 1e-5;
+    FactorCache cache;
+    X[exact] = m.tissue.X0;
+    st[exact] = solve_equilibrium(m.tissue, all_vertices(m.tissue), f, m.tissue.X0, X[exact], so, &cache);
+    ASSERT_TRUE(st[exact].converged) << st[exact].message;
+    control[exact].unit_load = [&](const Eigen::MatrixXd &P, Eigen::MatrixXd *F, NodeBlocks *K) {
+      return muscle_load(m.tissue, mu, 1.0, P, F, K);
+    };
+    control[exact].action = [&](const Eigen::MatrixXd &P, Eigen::MatrixXd *gradient) {
+      return muscle_action(m.tissue, mu, P, gradient);
+    };
+    control[exact].value = 0.5 * muscle_action_target(mu, true);
+    Xc[exact] = m.tissue.X0;
+    sc[exact] = solve_equilibrium(m.tissue, all_vertices(m.tissue), ForceField(), m.tissue.X0, Xc[exact], so,
+                                  &cache, &control[exact]);
+    ASSERT_TRUE(sc[exact].converged) << sc[exact].message;
+  }
+  EXPECT_LT((X[0] - X[1]).cwiseAbs().maxCoeff(), 2 * m.solver.tolerance);
+  EXPECT_LT(st[0].cg_iterations, st[1].cg_iterations);
+  EXPECT_LT((Xc[0] - Xc[1]).cwiseAbs().maxCoeff(), 2 * m.solver.tolerance);
+  EXPECT_NEAR(control[0].tension, control[1].tension, 1e-3 * control[1].tension);
+  EXPECT_LT(sc[0].cg_iterations, sc[1].cg_iterations);
+}
+
 TEST(Solver, ALoadThatMovesTheActionTheWrongWayFailsAtOnce) {
   // Load control from a tension already found (a solve beyond a FAP's
   // range starts so): the step clamp halves the tension each iteration
