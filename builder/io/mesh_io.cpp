@@ -292,14 +292,17 @@ Expected<ObjScan> scan_obj(const std::string &text, const std::string &path) {
 // `keep_all`: the part takes every vertex of the file, in file order, used or
 // not (a file with one group, so that vertex numbers stay the file's); else
 // only those its faces use, still in file order. Texture coordinates are
-// always only those the faces use.
+// always only those the faces use. When some of the group's faces have
+// texture coordinates and others none (a partial UV map), the corners of the
+// others take their vertex's coordinates from a face that has them, else
+// (0, 0), and `note` says so.
 Status read_obj_group(const std::string &text, const std::string &path, const ObjScan &scan,
-                      int group, bool keep_all, Part &part) {
+                      int group, bool keep_all, Part &part, std::string *note) {
   std::vector<const ObjFace *> faces;
   for (const ObjFace &f : scan.faces)
     if (f.group == group) faces.push_back(&f);
   const bool with_tc =
-      std::all_of(faces.begin(), faces.end(), [](const ObjFace *f) { return !f->vt.empty(); });
+      std::any_of(faces.begin(), faces.end(), [](const ObjFace *f) { return !f->vt.empty(); });
 
   std::string sub;
   sub.reserve(text.size());
@@ -368,21 +371,53 @@ Status read_obj_group(const std::string &text, const std::string &path, const Ob
       const OmMesh::Point p = mesh.point(OmMesh::VertexHandle(v));
       part.V.row(remap[v]) << p[0], p[1], p[2];
     }
-  part.TC.resize(with_tc ? ntused : 0, 2);
-  if (with_tc)
+  // The corners of faces without coordinates: their vertex's from the first
+  // face that gives it some, else the extra (0, 0) row after the others.
+  std::vector<int> vertex_tc(static_cast<size_t>(scan.nv), -1);
+  int bare = 0, bare_line = 0, unmapped = 0;
+  for (const ObjFace *f : faces)
+    for (size_t c = 0; c < f->vt.size(); ++c)
+      if (vertex_tc[static_cast<size_t>(f->v[c])] < 0) vertex_tc[static_cast<size_t>(f->v[c])] = tremap[f->vt[c]];
+  std::vector<std::vector<int>> corners_tc(faces.size());
+  for (size_t fk = 0; with_tc && fk < faces.size(); ++fk) {
+    const ObjFace &f = *faces[fk];
+    std::vector<int> &tc = corners_tc[fk];
+    if (!f.vt.empty()) {
+      for (int t : f.vt) tc.push_back(tremap[t]);
+      continue;
+    }
+    if (bare++ == 0) bare_line = f.line;
+    for (int v : f.v) {
+      const int t = vertex_tc[static_cast<size_t>(v)];
+      if (t < 0) ++unmapped;
+      tc.push_back(t < 0 ? ntused : t);
+    }
+  }
+  part.TC.resize(with_tc ? ntused + (unmapped > 0 ? 1 : 0) : 0, 2);
+  if (with_tc) {
     for (size_t t = 0; t < scan.vt.size(); ++t)
       if (tremap[t] >= 0) part.TC.row(tremap[t]) = scan.vt[t].transpose();
+    if (unmapped > 0) part.TC.row(ntused).setZero();
+  }
+  if (bare > 0 && note) {
+    *note = where + ": " + std::to_string(bare) + " of " + std::to_string(faces.size()) +
+            " faces have no texture coordinates (the first at line " + std::to_string(bare_line) +
+            "): their corners take their vertex's from the other faces" +
+            (unmapped > 0 ? ", or (0, 0) where none has any (" + std::to_string(unmapped) + " corners)" : std::string());
+  }
 
   int ntri = 0;
   for (const ObjFace *f : faces) ntri += static_cast<int>(f->v.size()) - 2;
   part.F.resize(ntri, 3);
   part.FTC.resize(with_tc ? ntri : 0, 3);
   int row = 0;
-  for (const ObjFace *f : faces)
+  for (size_t fk = 0; fk < faces.size(); ++fk) {
+    const ObjFace *f = faces[fk];
     for (size_t c = 1; c + 1 < f->v.size(); ++c, ++row) {
       part.F.row(row) << remap[f->v[0]], remap[f->v[c]], remap[f->v[c + 1]];
-      if (with_tc) part.FTC.row(row) << tremap[f->vt[0]], tremap[f->vt[c]], tremap[f->vt[c + 1]];
+      if (with_tc) part.FTC.row(row) << corners_tc[fk][0], corners_tc[fk][c], corners_tc[fk][c + 1];
     }
+  }
   part.C.resize(0, 3);
   return Status::ok();
 }
@@ -451,7 +486,9 @@ Expected<Scene> read_obj(const std::string &path) {
     std::string name = scan->groups[g].empty() ? scene.name : scan->groups[g];
     part.name = name;
     for (int k = 2; scene.find_part(part.name) >= 0; ++k) part.name = name + "_" + std::to_string(k);
-    if (Status st = read_obj_group(*text, path, *scan, g, single, part); !st) return st;
+    std::string note;
+    if (Status st = read_obj_group(*text, path, *scan, g, single, part, &note); !st) return st;
+    if (!note.empty()) scene.notes.push_back(note);
     part.kind = guess_part_kind(part);
     scene.parts.push_back(std::move(part));
     part_group.push_back(g);

@@ -106,6 +106,40 @@ TEST(MeshIo, ObjGroupsBecomePartsWithTexcoords) {
   EXPECT_EQ(b.TC.rows(), 0);
 }
 
+TEST(MeshIo, ObjFacesWithoutTexcoordsTakeTheirVerticesFromTheOthers) {
+  // A partial UV map: two faces of the group have coordinates, two none.
+  // Before, the whole group lost its coordinates (and a textured head its
+  // texture).
+  const std::string dir = afmtest::temp_dir("mesh_io_partial_vt");
+  const std::string path = dir + "/p.obj";
+  write_text(path,
+             "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 2 1 0\n"
+             "vt 0.1 0.2\nvt 0.3 0.4\nvt 0.5 0.6\nvt 0.7 0.8\n"
+             "g face\n"
+             "f 1/1 2/2 3/3\n"
+             "f 1/1 3/3 4/4\n"
+             "f 2 5 3\n"
+             "f 5 6 3\n");
+  auto s = afmb::read_scene(path);
+  ASSERT_TRUE(s) << s.status().message();
+  ASSERT_EQ(s->parts.size(), 1u);
+  const afmb::Part &p = s->parts[0];
+  ASSERT_EQ(p.TC.rows(), 5) << "the four written, and (0, 0) for the vertices no face maps";
+  ASSERT_EQ(p.FTC.rows(), 4);
+  // Face 3 (2 5 3): vertex 2 as face 1 maps it, 5 unmapped, 3 as face 1.
+  EXPECT_EQ(p.TC.row(p.FTC(2, 0)), Eigen::RowVector2d(0.3, 0.4));
+  EXPECT_EQ(p.TC.row(p.FTC(2, 1)), Eigen::RowVector2d(0, 0));
+  EXPECT_EQ(p.TC.row(p.FTC(2, 2)), Eigen::RowVector2d(0.5, 0.6));
+  EXPECT_EQ(p.TC.row(p.FTC(3, 2)), Eigen::RowVector2d(0.5, 0.6));
+  // The faces that have coordinates keep them.
+  EXPECT_EQ(p.TC.row(p.FTC(1, 2)), Eigen::RowVector2d(0.7, 0.8));
+  ASSERT_EQ(s->notes.size(), 1u);
+  EXPECT_NE(s->notes[0].find("p.obj (group 'face'): 2 of 4 faces have no texture coordinates (the first at line 14)"),
+            std::string::npos)
+      << s->notes[0];
+  EXPECT_NE(s->notes[0].find("(0, 0) where none has any (3 corners)"), std::string::npos) << s->notes[0];
+}
+
 TEST(MeshIo, ObjMaterialsGiveEachPartItsColourAndTexture) {
   const std::string dir = afmtest::temp_dir("mesh_io_mtl");
   const std::string path = dir + "/m.obj";
