@@ -226,8 +226,9 @@ struct System {
           const Element &e = elements[static_cast<size_t>(x)];
           for (int c = 0; c < 9; ++c) {
             if (e.local[c] != j) continue;
+            Block *out = &element_blocks[81 * static_cast<size_t>(x)];
             for (int r = 0; r < 9; ++r)
-              if (e.local[r] >= 0) element_blocks[81 * static_cast<size_t>(x) + static_cast<size_t>(9 * r + c)] = at(e.local[r]);
+              if (e.local[r] >= 0) out[9 * r + c] = at(e.local[r]);
           }
         } else {
           const size_t q = static_cast<size_t>(-1 - x);

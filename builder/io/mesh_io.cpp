@@ -403,7 +403,8 @@ Status read_obj_group(const std::string &text, const std::string &path, const Ob
     *note = where + ": " + std::to_string(bare) + " of " + std::to_string(faces.size()) +
             " faces have no texture coordinates (the first at line " + std::to_string(bare_line) +
             "): their corners take their vertex's from the other faces" +
-            (unmapped > 0 ? ", or (0, 0) where none has any (" + std::to_string(unmapped) + " corners)" : std::string());
+            (unmapped > 0 ? ", or (0, 0) where none has any (" + std::to_string(unmapped) + " corners)"
+                          : std::string());
   }
 
   int ntri = 0;
