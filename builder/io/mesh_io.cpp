@@ -5,13 +5,16 @@
 
 #include "io/mesh_io.h"
 
+#include <Eigen/Geometry>
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
 #include <OpenMesh/Core/System/omstream.hh>
 
 #include <algorithm>
+#include <array>
 #include <filesystem>
 #include <cerrno>
+#include <cmath>
 #include <charconv>
 #include <cstring>
 #include <exception>
@@ -20,6 +23,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <tuple>
 #include <unordered_map>
 #include <vector>
 
@@ -610,6 +614,96 @@ long stated_face_count(const std::string &path, const std::string &ext) {
   return counts.size() >= 2 && parse_int(counts[1], &nf) ? nf : -1;
 }
 
+// Closed surfaces that touch along a line (teeth rows) share, once welded,
+// edges in four triangles. Around such an edge a -> b, each surface's two
+// triangles bound its inside: going round the edge (right-handed about
+// b - a), a triangle that runs the edge b -> a faces its inside ahead, one
+// that runs it a -> b behind, so each b -> a triangle pairs with the next
+// one round, which must run a -> b. The surfaces are the triangles joined
+// through edges in two triangles and through these pairs; each vertex used
+// by several surfaces gets one copy per surface after the first (appended
+// to V). Left alone (returns 0) where an edge is in an odd number of
+// triangles above one, or its triangles do not alternate round it: nothing
+// tells the surfaces apart there, and check_skin() names it. Returns how
+// many vertices were split.
+int split_touching_surfaces(Eigen::MatrixXd &V, Eigen::MatrixXi &F) {
+  std::map<std::pair<int, int>, std::vector<int>> edges;
+  for (int t = 0; t < F.rows(); ++t)
+    for (int c = 0; c < 3; ++c) {
+      const int a = F(t, c), b = F(t, (c + 1) % 3);
+      edges[{std::min(a, b), std::max(a, b)}].push_back(t);
+    }
+  // The triangle's corner that is neither end of edge (a, b); whether it
+  // runs the edge a -> b.
+  auto third = [&](int t, int a, int b) {
+    for (int c = 0; c < 3; ++c)
+      if (F(t, c) != a && F(t, c) != b) return F(t, c);
+    return -1;
+  };
+  auto runs_forward = [&](int t, int a, int b) {
+    for (int c = 0; c < 3; ++c)
+      if (F(t, c) == a) return F(t, (c + 1) % 3) == b;
+    return false;
+  };
+  std::vector<int> root(static_cast<size_t>(F.rows()));
+  for (size_t t = 0; t < root.size(); ++t) root[t] = static_cast<int>(t);
+  auto find = [&](int t) {
+    while (root[static_cast<size_t>(t)] != t) {
+      root[static_cast<size_t>(t)] = root[static_cast<size_t>(root[static_cast<size_t>(t)])];
+      t = root[static_cast<size_t>(t)];
+    }
+    return t;
+  };
+  for (const auto &[edge, ts] : edges) {
+    if (ts.size() % 2 == 1 && ts.size() > 2) return 0;
+    if (ts.size() == 2) root[static_cast<size_t>(find(ts[0]))] = find(ts[1]);
+    if (ts.size() < 4) continue;
+    const auto [a, b] = edge;
+    const Eigen::Vector3d origin = V.row(a).transpose(), axis = (V.row(b) - V.row(a)).transpose().normalized();
+    Eigen::Vector3d ref = Eigen::Vector3d::Zero();
+    // (angle about the axis, runs b -> a, triangle). Two triangles in one
+    // half-plane (surfaces in contact over a face) meet outside either
+    // surface: the one that closes its surface's inside (a -> b) first.
+    std::vector<std::tuple<double, bool, int>> round;
+    for (int t : ts) {
+      Eigen::Vector3d u = V.row(third(t, a, b)).transpose() - origin;
+      u -= u.dot(axis) * axis;
+      if (ref.isZero()) ref = u.normalized();
+      round.emplace_back(std::atan2(axis.cross(ref).dot(u), ref.dot(u)), !runs_forward(t, a, b), t);
+    }
+    std::sort(round.begin(), round.end());
+    // Start at a b -> a triangle; then they must alternate.
+    size_t first = 0;
+    while (first < round.size() && !std::get<1>(round[first])) ++first;
+    for (size_t k = 0; k < round.size(); k += 2) {
+      const int from = std::get<2>(round[(first + k) % round.size()]);
+      const int to = std::get<2>(round[(first + k + 1) % round.size()]);
+      if (runs_forward(from, a, b) || !runs_forward(to, a, b)) return 0;
+      root[static_cast<size_t>(find(from))] = find(to);
+    }
+  }
+  const int nv = static_cast<int>(V.rows());
+  std::vector<std::map<int, int>> copy_of(static_cast<size_t>(nv));  // per vertex: surface -> its vertex
+  std::vector<Eigen::RowVector3d> copies;
+  int split = 0;
+  for (int t = 0; t < F.rows(); ++t)
+    for (int c = 0; c < 3; ++c) {
+      const int v = F(t, c), surface = find(t);
+      std::map<int, int> &m = copy_of[static_cast<size_t>(v)];
+      auto it = m.find(surface);
+      if (it == m.end()) {
+        if (m.size() == 1) ++split;
+        const int id = m.empty() ? v : nv + static_cast<int>(copies.size());
+        if (!m.empty()) copies.push_back(V.row(v));
+        it = m.insert({surface, id}).first;
+      }
+      F(t, c) = it->second;
+    }
+  V.conservativeResize(nv + static_cast<Eigen::Index>(copies.size()), 3);
+  for (size_t k = 0; k < copies.size(); ++k) V.row(nv + static_cast<Eigen::Index>(k)) = copies[k];
+  return split;
+}
+
 Expected<Scene> read_single(const std::string &path, const std::string &ext) {
   OmMesh mesh;
   mesh.request_face_status();
@@ -641,9 +735,27 @@ Expected<Scene> read_single(const std::string &path, const std::string &ext) {
     const OmMesh::Point p = mesh.point(vh);
     part.V.row(vh.idx()) << p[0], p[1], p[2];
   }
+  // STL holds loose triangles, which OpenMesh joins at equal positions. Two
+  // closed surfaces that touch (teeth rows) then share vertices and edges,
+  // and OpenMesh holds some of their faces only on copies of their corners,
+  // cut off from their neighbours. So for STL the copies go back to the
+  // vertex at their position, and the surfaces are taken apart again
+  // (split_touching_surfaces), with a note. Other formats number their
+  // vertices: such a face is an error there.
+  const bool stl = ext == ".stl";
+  std::vector<int> canonical(static_cast<size_t>(nv));
+  int rewelded = 0;
+  if (stl) {
+    std::map<std::array<double, 3>, int> at;
+    for (int v = 0; v < nv; ++v) {
+      const auto [it, fresh] = at.insert({{part.V(v, 0), part.V(v, 1), part.V(v, 2)}, v});
+      canonical[static_cast<size_t>(v)] = it->second;
+      if (!fresh) ++rewelded;
+    }
+  }
   int ntri = 0;
   for (OmMesh::FaceHandle fh : mesh.faces()) {
-    if (mesh.status(fh).fixed_nonmanifold())
+    if (mesh.status(fh).fixed_nonmanifold() && !stl)
       return Status::error(path + ": face " + std::to_string(fh.idx()) +
                            " is not manifold (an edge in three faces, an edge used twice in the "
                            "same direction, or a vertex joining two fans): OpenMesh can only hold "
@@ -654,9 +766,28 @@ Expected<Scene> read_single(const std::string &path, const std::string &ext) {
   int row = 0;
   for (OmMesh::FaceHandle fh : mesh.faces()) {
     std::vector<int> v;
-    for (OmMesh::VertexHandle vh : mesh.fv_range(fh)) v.push_back(vh.idx());
+    for (OmMesh::VertexHandle vh : mesh.fv_range(fh))
+      v.push_back(stl ? canonical[static_cast<size_t>(vh.idx())] : vh.idx());
     for (size_t c = 1; c + 1 < v.size(); ++c, ++row) part.F.row(row) << v[0], v[c], v[c + 1];
   }
+  std::string stl_note;
+  if (stl && rewelded > 0) {
+    // Drop the copies: an STL has no vertex numbers to keep.
+    std::vector<int> keep(static_cast<size_t>(nv), -1);
+    int kept = 0;
+    for (int v = 0; v < nv; ++v)
+      if (canonical[static_cast<size_t>(v)] == v) keep[static_cast<size_t>(v)] = kept++;
+    Eigen::MatrixXd V(kept, 3);
+    for (int v = 0; v < nv; ++v)
+      if (keep[static_cast<size_t>(v)] >= 0) V.row(keep[static_cast<size_t>(v)]) = part.V.row(v);
+    for (Eigen::Index t = 0; t < part.F.rows(); ++t)
+      for (int c = 0; c < 3; ++c) part.F(t, c) = keep[static_cast<size_t>(part.F(t, c))];
+    part.V = std::move(V);
+  }
+  if (stl)
+    if (const int split = split_touching_surfaces(part.V, part.F); split > 0)
+      stl_note = path + ": " + std::to_string(split) + (split == 1 ? " vertex joins" : " vertices join") +
+                 " closed surfaces that touch (as teeth rows do): split, one per surface";
   part.C.resize(0, 3);
   if (opt.vertex_has_color()) {
     part.C.resize(nv, 3);
@@ -681,6 +812,7 @@ Expected<Scene> read_single(const std::string &path, const std::string &ext) {
   part.name = scene.name;
   part.kind = guess_part_kind(part);
   scene.parts.push_back(std::move(part));
+  if (!stl_note.empty()) scene.notes.push_back(stl_note);
   return scene;
 }
 

@@ -8,8 +8,10 @@
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 
+#include <array>
 #include <fstream>
 #include <regex>
+#include <set>
 #include <sstream>
 #include <string>
 
@@ -248,6 +250,60 @@ TEST(MeshIo, PlyOffStlFromOpenMeshLoadBack) {
       }
     }
   }
+}
+
+TEST(MeshIo, StlSurfacesTouchingAtAPointComeApart) {
+  // Two closed tetrahedra, apex to apex (as touching teeth rows meet): STL
+  // has no vertex numbers, so OpenMesh joins the apexes, and the second
+  // tetrahedron's faces there could only be held on copies of their corners,
+  // cut off from their neighbours (before, an error). Now each surface keeps
+  // its own apex, and the rest of each stays joined.
+  const std::string dir = afmtest::temp_dir("mesh_io_stl_fans");
+  auto facet = [](const std::array<Eigen::Vector3d, 3> &p) {
+    std::ostringstream o;
+    o << "facet normal 0 0 0\n outer loop\n";
+    for (const Eigen::Vector3d &q : p) o << "  vertex " << q.x() << ' ' << q.y() << ' ' << q.z() << "\n";
+    o << " endloop\nendfacet\n";
+    return o.str();
+  };
+  // A tetrahedron with apex at the origin, pointing along `s` (+1 or -1 in z),
+  // wound outwards.
+  auto tetra = [&](double sz) {
+    const Eigen::Vector3d a(0, 0, 0), b(1, 0, sz), c(-0.5, 0.8, sz), d(-0.5, -0.8, sz);
+    std::string out;
+    if (sz > 0)
+      out = facet({a, c, b}) + facet({a, d, c}) + facet({a, b, d}) + facet({b, c, d});
+    else
+      out = facet({a, b, c}) + facet({a, c, d}) + facet({a, d, b}) + facet({b, d, c});
+    return out;
+  };
+  write_text(dir + "/touch.stl", "solid touch\n" + tetra(1) + tetra(-1) + "endsolid touch\n");
+  auto s = afmb::read_scene(dir + "/touch.stl");
+  ASSERT_TRUE(s) << s.status().message();
+  ASSERT_EQ(s->parts.size(), 1u);
+  const afmb::Part &p = s->parts[0];
+  ASSERT_EQ(p.F.rows(), 8);
+  ASSERT_EQ(p.V.rows(), 8) << "4 corners each; the apex twice";
+  // Triangles 0-3 and 4-7 share no vertex; within each, every corner is
+  // shared by three triangles (a closed tetrahedron).
+  std::set<int> first, second;
+  for (int t = 0; t < 8; ++t)
+    for (int c = 0; c < 3; ++c) (t < 4 ? first : second).insert(p.F(t, c));
+  EXPECT_EQ(first.size(), 4u);
+  EXPECT_EQ(second.size(), 4u);
+  for (int v : first) EXPECT_EQ(second.count(v), 0u) << v;
+  int apexes = 0;
+  for (Eigen::Index v = 0; v < p.V.rows(); ++v) apexes += p.V.row(v).isZero() ? 1 : 0;
+  EXPECT_EQ(apexes, 2);
+  ASSERT_EQ(s->notes.size(), 1u);
+  EXPECT_NE(s->notes[0].find("touch.stl: 1 vertex joins closed surfaces that touch"), std::string::npos)
+      << s->notes[0];
+  // One surface alone: nothing to split, no note.
+  write_text(dir + "/one.stl", "solid one\n" + tetra(1) + "endsolid one\n");
+  auto one = afmb::read_scene(dir + "/one.stl");
+  ASSERT_TRUE(one) << one.status().message();
+  EXPECT_EQ(one->parts[0].V.rows(), 4);
+  EXPECT_TRUE(one->notes.empty());
 }
 
 TEST(MeshIo, PlyVertexColours) {

@@ -68,6 +68,26 @@ done
 sed 's/vertex [0-9]*//' "$tmp/fdps_vertex.txt" | tr -s ' ' >"$tmp/fdps_places.txt"
 cmp -s "$tmp/fdps_places.txt" "$tmp/fdps_merged.txt" ||
   fail "the one-object head's FDPs moved: $(diff "$tmp/fdps_places.txt" "$tmp/fdps_merged.txt" | head -5)"
+# The same head as STL (loose triangles, welded at equal positions): the
+# touching teeth rows come apart again, each its own piece, and the FDPs
+# land where they were.
+awk '$1 == "v" { v[++n] = $2 " " $3 " " $4; next }
+     $1 == "f" { print "facet normal 0 0 0\n outer loop"
+                 for (k = 2; k <= 4; ++k) { split($k, c, "/"); print "  vertex " v[c[1]] }
+                 print " endloop\nendfacet" }
+     BEGIN { print "solid head" } END { print "endsolid head" }' "$tmp/head.obj" >"$tmp/head.stl"
+"$bin/afm-import" "$tmp/head.stl" "$tmp/coords.fdp" -o "$tmp/stl.afm" >"$tmp/stl.txt" 2>&1 ||
+  fail "afm-import of the head as STL failed: $(cat "$tmp/stl.txt")"
+grep -q "head\.stl: [0-9]* vertices join closed surfaces that touch" "$tmp/stl.txt" || fail "no STL split note: $(head -3 "$tmp/stl.txt")"
+grep -q "split into its 6 separate pieces" "$tmp/stl.txt" || fail "STL head: no split into 6 pieces: $(head -4 "$tmp/stl.txt")"
+for k in teeth_upper teeth_lower; do
+  want=$(grep -E "^  merged_$k +$k " "$tmp/merged.txt" | awk '{ print $2, $3, $4 }')
+  got=$(grep -E "^  head_$k +$k " "$tmp/stl.txt" | awk '{ print $2, $3, $4 }')
+  [ -n "$want" ] && [ "$got" = "$want" ] || fail "STL head: $k piece '$got', the one-object OBJ's '$want'"
+done
+"$bin/afm-info" --fdps "$tmp/stl.afm" | grep 'vertex [0-9]' | sed 's/vertex [0-9]*//' | tr -s ' ' >"$tmp/fdps_stl.txt"
+cmp -s "$tmp/fdps_places.txt" "$tmp/fdps_stl.txt" ||
+  fail "the STL head's FDPs moved: $(diff "$tmp/fdps_places.txt" "$tmp/fdps_stl.txt" | head -5)"
 # One object with a material per piece: each piece keeps its own texture.
 awk 'NR == 1 { print "mtllib parts.mtl" } /^o / { print "usemtl " $2; next } { print }' "$tmp/head.obj" >"$tmp/merged-mtl.obj"
 for m in skin eye_left eye_right teeth_upper teeth_lower tongue; do printf 'newmtl %s\nKd 1 1 1\nmap_Kd %s.png\n' $m $m; done >"$tmp/parts.mtl"
