@@ -886,6 +886,8 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
   int best_at = 0;
   int projected_run = 0;  // refreshes in a row that did not factorise the full tangent
   double shift = 1e-3;    // the last diagonal shift that made the full tangent definite
+  bool energy_known = false;  // known_energy is the total energy at X (see the line search)
+  double known_energy = 0;
   for (int it = 0;; ++it) {
     const ForceField load = load_at(t);
     net_force(sys, load, reference, X, r);
@@ -1059,7 +1061,8 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     Vec rn = rf;
     if (control) rn += dt * [&] { Vec gf = g; contacts.filter(gf); return gf; }();
     x0 = gather_rows(sys, X);
-    const double e0 = total_energy(sys, next_load, reference, X), slope = rn.dot(dx);
+    const double e0 = energy_known ? known_energy : total_energy(sys, next_load, reference, X);
+    const double slope = rn.dot(dx);
     double alpha = 1, e_trial = 0;
     Eigen::MatrixXd Xt = X;
     for (int ls = 0; ls < 12; ++ls) {
@@ -1074,20 +1077,27 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     // soften, and Newton then crawls along it a step of the same length at a
     // time (the 10k head's zygomaticus major: 32 iterations). Twice, four and
     // eight times the step are tried while the energy keeps falling.
+    double e_taken = e_trial;
     if (options.extend_steps && !full && alpha == 1) {
-      double e_best = e_trial;
       for (double longer : {2.0, 4.0, 8.0}) {
         const Vec further = x0 + longer * dx;
         scatter_rows(sys, further, Xt);
         const double e = total_energy(sys, next_load, reference, Xt);
-        if (!(std::isfinite(e) && e < e_best)) break;
-        e_best = e, trial = further, alpha = longer;
+        if (!(std::isfinite(e) && e < e_taken)) break;
+        e_taken = e, trial = further, alpha = longer;
       }
     }
     if (!finite(trial)) return done(false, name + ": non-finite step");
     scatter_rows(sys, trial, X);
     st.last_step = alpha * max_node_motion(dx);
-    st.last_step = std::max(st.last_step, update_contacts(sys, X, contacts));
+    const double held = update_contacts(sys, X, contacts);
+    st.last_step = std::max(st.last_step, held);
+    // The next step's line search starts from this energy when nothing
+    // changed since it was computed: no contact moved a node, and the load
+    // is the same (no tension to solve for). The same number, one energy
+    // evaluation less per step (about 2 % of the CPU of Song's AFM).
+    energy_known = !control && held == 0;
+    known_energy = e_taken;
     st.iterations = it + 1;
   }
   if (control) control->tension = t;
