@@ -3,11 +3,13 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <limits>
 #include <map>
 #include <numeric>
 #include <queue>
 #include <set>
+#include <tuple>
 
 #include "core/part_kind.h"
 
@@ -382,6 +384,76 @@ int cut_fused_lips(Scene &scene, int part_index, FdpSet &fdps, std::vector<std::
                    std::to_string(upper) + "): cut along the lip line from 2.4 to 2.5 (" + std::to_string(added + 1) +
                    " edges), its " + std::to_string(added) + " inner vertices doubled, so that the mouth can open");
   return added;
+}
+
+int split_touching_surfaces(Eigen::MatrixXd &V, Eigen::MatrixXi &F) {
+  std::map<std::pair<int, int>, std::vector<int>> edges;
+  for (int t = 0; t < F.rows(); ++t)
+    for (int c = 0; c < 3; ++c) {
+      const int a = F(t, c), b = F(t, (c + 1) % 3);
+      edges[{std::min(a, b), std::max(a, b)}].push_back(t);
+    }
+  // The triangle's corner that is neither end of edge (a, b); whether it
+  // runs the edge a -> b.
+  auto third = [&](int t, int a, int b) {
+    for (int c = 0; c < 3; ++c)
+      if (F(t, c) != a && F(t, c) != b) return F(t, c);
+    return -1;
+  };
+  auto runs_forward = [&](int t, int a, int b) {
+    for (int c = 0; c < 3; ++c)
+      if (F(t, c) == a) return F(t, (c + 1) % 3) == b;
+    return false;
+  };
+  Unions surfaces(static_cast<size_t>(F.rows()));
+  for (const auto &[edge, ts] : edges) {
+    if (ts.size() % 2 == 1 && ts.size() > 2) return 0;
+    if (ts.size() == 2) surfaces.join(ts[0], ts[1]);
+    if (ts.size() < 4) continue;
+    const auto [a, b] = edge;
+    const Eigen::Vector3d origin = V.row(a).transpose(), axis = (V.row(b) - V.row(a)).transpose().normalized();
+    Eigen::Vector3d ref = Eigen::Vector3d::Zero();
+    // (angle about the axis, runs b -> a, triangle). Two triangles in one
+    // half-plane (surfaces in contact over a face) meet outside either
+    // surface: the one that closes its surface's inside (a -> b) first.
+    std::vector<std::tuple<double, bool, int>> round;
+    for (int t : ts) {
+      Eigen::Vector3d u = V.row(third(t, a, b)).transpose() - origin;
+      u -= u.dot(axis) * axis;
+      if (ref.isZero()) ref = u.normalized();
+      round.emplace_back(std::atan2(axis.cross(ref).dot(u), ref.dot(u)), !runs_forward(t, a, b), t);
+    }
+    std::sort(round.begin(), round.end());
+    // Start at a b -> a triangle; then they must alternate.
+    size_t first = 0;
+    while (first < round.size() && !std::get<1>(round[first])) ++first;
+    for (size_t k = 0; k < round.size(); k += 2) {
+      const int from = std::get<2>(round[(first + k) % round.size()]);
+      const int to = std::get<2>(round[(first + k + 1) % round.size()]);
+      if (runs_forward(from, a, b) || !runs_forward(to, a, b)) return 0;
+      surfaces.join(from, to);
+    }
+  }
+  const int nv = static_cast<int>(V.rows());
+  std::vector<std::map<int, int>> copy_of(static_cast<size_t>(nv));  // per vertex: surface -> its vertex
+  std::vector<Eigen::RowVector3d> copies;
+  int split = 0;
+  for (int t = 0; t < F.rows(); ++t)
+    for (int c = 0; c < 3; ++c) {
+      const int v = F(t, c), surface = surfaces.root(t);
+      std::map<int, int> &m = copy_of[static_cast<size_t>(v)];
+      auto it = m.find(surface);
+      if (it == m.end()) {
+        if (m.size() == 1) ++split;
+        const int id = m.empty() ? v : nv + static_cast<int>(copies.size());
+        if (!m.empty()) copies.push_back(V.row(v));
+        it = m.insert({surface, id}).first;
+      }
+      F(t, c) = it->second;
+    }
+  V.conservativeResize(nv + static_cast<Eigen::Index>(copies.size()), 3);
+  for (size_t k = 0; k < copies.size(); ++k) V.row(nv + static_cast<Eigen::Index>(k)) = copies[k];
+  return split;
 }
 
 }  // namespace afmb

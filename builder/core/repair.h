@@ -1,6 +1,7 @@
 // Unambiguous repairs of real-world skins, reported, never silent.
 #pragma once
 
+#include <Eigen/Core>
 #include <string>
 #include <vector>
 
@@ -57,5 +58,20 @@ int split_skin_pieces(Scene &scene, int part, FdpSet &fdps, std::vector<std::str
 // through one vertex twice; else appends one line to `log` and returns how
 // many vertices were copied.
 int cut_fused_lips(Scene &scene, int part, FdpSet &fdps, std::vector<std::string> *log);
+
+// Closed surfaces that touch along a line (teeth rows) share, once welded,
+// edges in four triangles. Around such an edge a -> b, each surface's two
+// triangles bound its inside: going round the edge (right-handed about
+// b - a), a triangle that runs the edge b -> a faces its inside ahead, one
+// that runs it a -> b behind, so each b -> a triangle pairs with the next
+// one round, which must run a -> b. The surfaces are the triangles joined
+// through edges in two triangles and through these pairs; each vertex used
+// by several surfaces gets one copy per surface after the first (appended
+// to V). Left alone (returns 0) where an edge is in an odd number of
+// triangles above one, or its triangles do not alternate round it: nothing
+// tells the surfaces apart there, and check_skin() names it. Returns how
+// many vertices were split. V #V x 3 (grows by the copies), F #F x 3
+// (rewritten). The STL reader calls it on the triangles it has welded.
+int split_touching_surfaces(Eigen::MatrixXd &V, Eigen::MatrixXi &F);
 
 }  // namespace afmb

@@ -5,7 +5,6 @@
 
 #include "io/mesh_io.h"
 
-#include <Eigen/Geometry>
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
 #include <OpenMesh/Core/System/omstream.hh>
@@ -14,7 +13,6 @@
 #include <array>
 #include <filesystem>
 #include <cerrno>
-#include <cmath>
 #include <charconv>
 #include <cstring>
 #include <exception>
@@ -23,12 +21,12 @@
 #include <map>
 #include <set>
 #include <sstream>
-#include <tuple>
 #include <unordered_map>
 #include <vector>
 
 #include "core/atomic_file.h"
 #include "core/part_kind.h"
+#include "core/repair.h"
 #include "io/vrml.h"
 
 namespace afmb {
@@ -614,96 +612,6 @@ long stated_face_count(const std::string &path, const std::string &ext) {
   return counts.size() >= 2 && parse_int(counts[1], &nf) ? nf : -1;
 }
 
-// Closed surfaces that touch along a line (teeth rows) share, once welded,
-// edges in four triangles. Around such an edge a -> b, each surface's two
-// triangles bound its inside: going round the edge (right-handed about
-// b - a), a triangle that runs the edge b -> a faces its inside ahead, one
-// that runs it a -> b behind, so each b -> a triangle pairs with the next
-// one round, which must run a -> b. The surfaces are the triangles joined
-// through edges in two triangles and through these pairs; each vertex used
-// by several surfaces gets one copy per surface after the first (appended
-// to V). Left alone (returns 0) where an edge is in an odd number of
-// triangles above one, or its triangles do not alternate round it: nothing
-// tells the surfaces apart there, and check_skin() names it. Returns how
-// many vertices were split.
-int split_touching_surfaces(Eigen::MatrixXd &V, Eigen::MatrixXi &F) {
-  std::map<std::pair<int, int>, std::vector<int>> edges;
-  for (int t = 0; t < F.rows(); ++t)
-    for (int c = 0; c < 3; ++c) {
-      const int a = F(t, c), b = F(t, (c + 1) % 3);
-      edges[{std::min(a, b), std::max(a, b)}].push_back(t);
-    }
-  // The triangle's corner that is neither end of edge (a, b); whether it
-  // runs the edge a -> b.
-  auto third = [&](int t, int a, int b) {
-    for (int c = 0; c < 3; ++c)
-      if (F(t, c) != a && F(t, c) != b) return F(t, c);
-    return -1;
-  };
-  auto runs_forward = [&](int t, int a, int b) {
-    for (int c = 0; c < 3; ++c)
-      if (F(t, c) == a) return F(t, (c + 1) % 3) == b;
-    return false;
-  };
-  std::vector<int> root(static_cast<size_t>(F.rows()));
-  for (size_t t = 0; t < root.size(); ++t) root[t] = static_cast<int>(t);
-  auto find = [&](int t) {
-    while (root[static_cast<size_t>(t)] != t) {
-      root[static_cast<size_t>(t)] = root[static_cast<size_t>(root[static_cast<size_t>(t)])];
-      t = root[static_cast<size_t>(t)];
-    }
-    return t;
-  };
-  for (const auto &[edge, ts] : edges) {
-    if (ts.size() % 2 == 1 && ts.size() > 2) return 0;
-    if (ts.size() == 2) root[static_cast<size_t>(find(ts[0]))] = find(ts[1]);
-    if (ts.size() < 4) continue;
-    const auto [a, b] = edge;
-    const Eigen::Vector3d origin = V.row(a).transpose(), axis = (V.row(b) - V.row(a)).transpose().normalized();
-    Eigen::Vector3d ref = Eigen::Vector3d::Zero();
-    // (angle about the axis, runs b -> a, triangle). Two triangles in one
-    // half-plane (surfaces in contact over a face) meet outside either
-    // surface: the one that closes its surface's inside (a -> b) first.
-    std::vector<std::tuple<double, bool, int>> round;
-    for (int t : ts) {
-      Eigen::Vector3d u = V.row(third(t, a, b)).transpose() - origin;
-      u -= u.dot(axis) * axis;
-      if (ref.isZero()) ref = u.normalized();
-      round.emplace_back(std::atan2(axis.cross(ref).dot(u), ref.dot(u)), !runs_forward(t, a, b), t);
-    }
-    std::sort(round.begin(), round.end());
-    // Start at a b -> a triangle; then they must alternate.
-    size_t first = 0;
-    while (first < round.size() && !std::get<1>(round[first])) ++first;
-    for (size_t k = 0; k < round.size(); k += 2) {
-      const int from = std::get<2>(round[(first + k) % round.size()]);
-      const int to = std::get<2>(round[(first + k + 1) % round.size()]);
-      if (runs_forward(from, a, b) || !runs_forward(to, a, b)) return 0;
-      root[static_cast<size_t>(find(from))] = find(to);
-    }
-  }
-  const int nv = static_cast<int>(V.rows());
-  std::vector<std::map<int, int>> copy_of(static_cast<size_t>(nv));  // per vertex: surface -> its vertex
-  std::vector<Eigen::RowVector3d> copies;
-  int split = 0;
-  for (int t = 0; t < F.rows(); ++t)
-    for (int c = 0; c < 3; ++c) {
-      const int v = F(t, c), surface = find(t);
-      std::map<int, int> &m = copy_of[static_cast<size_t>(v)];
-      auto it = m.find(surface);
-      if (it == m.end()) {
-        if (m.size() == 1) ++split;
-        const int id = m.empty() ? v : nv + static_cast<int>(copies.size());
-        if (!m.empty()) copies.push_back(V.row(v));
-        it = m.insert({surface, id}).first;
-      }
-      F(t, c) = it->second;
-    }
-  V.conservativeResize(nv + static_cast<Eigen::Index>(copies.size()), 3);
-  for (size_t k = 0; k < copies.size(); ++k) V.row(nv + static_cast<Eigen::Index>(k)) = copies[k];
-  return split;
-}
-
 Expected<Scene> read_single(const std::string &path, const std::string &ext) {
   OmMesh mesh;
   mesh.request_face_status();
@@ -740,7 +648,7 @@ Expected<Scene> read_single(const std::string &path, const std::string &ext) {
   // and OpenMesh holds some of their faces only on copies of their corners,
   // cut off from their neighbours. So for STL the copies go back to the
   // vertex at their position, and the surfaces are taken apart again
-  // (split_touching_surfaces), with a note. Other formats number their
+  // (split_touching_surfaces, core/repair.h), with a note. Other formats number their
   // vertices: such a face is an error there.
   const bool stl = ext == ".stl";
   std::vector<int> canonical(static_cast<size_t>(nv));
