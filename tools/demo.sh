@@ -41,10 +41,10 @@ awk 'BEGIN {
     print mask
     k = int(i / 6) + 1; blend = int(63 * (i % 6) / 5)
     joy = (i < 40) ? int(63 * sin(pi * i / 40)) : 0
-    # The lids close by 600 IRISD units, the in-between target of the upper
-    # lids (report/): past it (1024 shuts the neutral eye of MPEG-4) the lid
-    # of the generated head is extrapolated.
-    lid = (i >= 50 && i <= 56) ? int(600 * sin(pi * (i - 50) / 6)) : 0
+    # A whole blink: 1024 IRISD units shut the neutral eye of MPEG-4, whose
+    # lids touch the iris (the upper lids have targets at 300, 600 and 1024:
+    # report/).
+    lid = (i >= 50 && i <= 56) ? int(1024 * sin(pi * (i - 50) / 6)) : 0
     yaw = (i >= 40) ? int(35000 * sin(2 * pi * (i - 40) / 35)) : 0
     printf "%d %d %d %d 0 1 %d 0 0 0 0 %d %d %d\n", i, vis[k + 1], vis[k], blend, joy, lid, lid, yaw
   }

@@ -42,9 +42,13 @@ std::vector<int> with_rings(const SkinModel &skin, const std::vector<int> &set, 
   return out;
 }
 
-// Largest motion (any layer) of a vertex of `set` that has a neighbour outside it.
-double border_motion(const SkinModel &skin, const std::vector<int> &set, const Eigen::MatrixXd &X) {
+// Largest motion (any layer) of a vertex of `set` that has a neighbour outside
+// it (and not `held`, when given: vertices placed by the pose, not solved).
+double border_motion(const SkinModel &skin, const std::vector<int> &set, const Eigen::MatrixXd &X,
+                     const std::vector<char> *held = nullptr) {
   std::vector<uint8_t> in(static_cast<size_t>(skin.n), 0);
+  if (held)
+    for (int v = 0; v < skin.n; ++v) in[static_cast<size_t>(v)] = (*held)[static_cast<size_t>(v)];
   for (int v : set) in[static_cast<size_t>(v)] = 1;
   double worst = 0;
   for (int v : set) {
@@ -60,16 +64,24 @@ double border_motion(const SkinModel &skin, const std::vector<int> &set, const E
 }
 
 // Solves on `set`, growing it until the wave dies out at its border.
+// `held` (when given, one flag per skin vertex): vertices that stay where X
+// has them, never in the set.
 Status solve_growing(const FaceModel &model, std::vector<int> &set, const ForceField &forces,
                      const Eigen::MatrixXd &reference, Eigen::MatrixXd &X, const SolverOptions &opts,
                      double threshold, FactorCache *cache, bool whole, SolveStats *stats, int *rounds,
-                     LoadControl *control = nullptr) {
+                     LoadControl *control = nullptr, const std::vector<char> *held = nullptr) {
   const SkinModel &skin = model.tissue;
   if (whole) {
     set.clear();
     for (int v = 0; v < skin.n; ++v)
       if (skin.in_mesh[static_cast<size_t>(v)]) set.push_back(v);
   }
+  auto unheld = [&] {
+    if (held)
+      set.erase(std::remove_if(set.begin(), set.end(), [&](int v) { return (*held)[static_cast<size_t>(v)] != 0; }),
+                set.end());
+  };
+  unheld();
   int total_it = 0, total_cg = 0, total_fact = 0;
   double total_seconds = 0;
   for (int round = 0;; ++round) {
@@ -85,9 +97,10 @@ Status solve_growing(const FaceModel &model, std::vector<int> &set, const ForceF
     if (stats) *stats = st;
     if (rounds) *rounds = round + 1;
     if (!st.converged) return Status::error(st.message);
-    if (whole || border_motion(skin, set, X) <= threshold) return Status::ok();
+    if (whole || border_motion(skin, set, X, held) <= threshold) return Status::ok();
     const size_t before = set.size();
     set = with_rings(skin, set, 2 << std::min(round, 4));
+    unheld();
     if (set.size() == before) return Status::ok();  // the whole connected skin
   }
 }
@@ -258,6 +271,18 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
   for (const Muscle &m : model.muscles)
     if (table[static_cast<size_t>(m.def)].skull_free)
       for (int v : m.influence) model.tissue.skull_free[static_cast<size_t>(v)] = 1;
+  // A lid turned far (Activation::lids) brings skin from above the eye,
+  // beyond the band of SkinModel::eye_near, over the ball: the solver holds
+  // the lid's skin outside its eyeball off it (not the skin turning into the
+  // socket, inside the sphere at rest).
+  for (const Muscle &m : model.muscles) {
+    if (m.kind != MuscleKind::Lid || m.eye < 0) continue;
+    const EyeSphere &ball = model.tissue.eyes[static_cast<size_t>(m.eye)];
+    for (int v : m.influence)
+      if (model.tissue.eye_near[static_cast<size_t>(v)] < 0 &&
+          (model.tissue.X0.row(model.tissue.node(kEpidermis, v)).transpose() - ball.centre).norm() > ball.radius)
+        hold_off_eyeball(model.tissue, v, m.eye);
+  }
   progress(2, steps_fixed, "muscles placed");
 
   Expected<Jaw> jaw = build_jaw(model.tissue, model.fdps, model.fapu, *lips);
@@ -438,6 +463,52 @@ Expected<Pose> solve_pose_to(const FaceModel &model, const std::vector<std::pair
   return pose;
 }
 
+Status place_turned_lid(const FaceModel &model, const LidTurn &lid, Eigen::MatrixXd &X, std::vector<char> *held) {
+  const SkinModel &skin = model.tissue;
+  const int muscle = lid.muscle;
+  const double angle = lid.angle;
+  if (muscle < 0 || muscle >= static_cast<int>(model.muscles.size()))
+    return Status::error("pose: muscle index " + std::to_string(muscle) + " out of range");
+  const Muscle &m = model.muscles[static_cast<size_t>(muscle)];
+  if (m.kind != MuscleKind::Lid || m.turn_share.size() != m.influence.size() || m.tarsus.size() != m.influence.size() ||
+      m.eye < 0 || m.eye >= static_cast<int>(skin.eyes.size()) || !std::isfinite(angle) ||
+      !(lid.clearance >= 0 && std::isfinite(lid.clearance)))
+    return Status::error("pose: " + m.name + " is not a lid that turns");
+  if (held) held->resize(static_cast<size_t>(skin.n), 0);
+  std::vector<char> tarsus(static_cast<size_t>(skin.n), 0);
+  for (size_t k = 0; k < m.influence.size(); ++k) {
+    const Eigen::AngleAxisd turn(angle * m.turn_share[k], m.axis);
+    const int v = m.influence[k];
+    for (int l = 0; l < kSkull; ++l) {
+      const int g = skin.node(l, v);
+      X.row(g) = (m.epicentre + turn * (Eigen::Vector3d(X.row(g)) - m.epicentre)).transpose();
+    }
+    tarsus[static_cast<size_t>(v)] = m.tarsus[k];
+  }
+  if (held)
+    for (int v = 0; v < skin.n; ++v) (*held)[static_cast<size_t>(v)] |= tarsus[static_cast<size_t>(v)];
+  // The tarsus's epidermis as far off the eyeball as the solver holds free
+  // skin (eye_clearance_in, over the tarsus's own edges: the skin around it
+  // is not placed yet): the chords between its nodes stay outside the ball,
+  // else the eye part shows through the shut lid.
+  const EyeSphere &ball = skin.eyes[static_cast<size_t>(m.eye)];
+  const Eigen::MatrixXd turned = X;
+  for (int v = 0; v < skin.n; ++v) {
+    if (!tarsus[static_cast<size_t>(v)] || skin.eye_near[static_cast<size_t>(v)] != m.eye) continue;
+    const int g = skin.node(kEpidermis, v);
+    double grown = 0;
+    for (int u : skin.neighbours[static_cast<size_t>(v)])
+      if (tarsus[static_cast<size_t>(u)] && skin.eye_near[static_cast<size_t>(u)] == m.eye)
+        grown = std::max(grown, (turned.row(g) - turned.row(skin.node(kEpidermis, u))).squaredNorm() -
+                                    (skin.X0.row(g) - skin.X0.row(skin.node(kEpidermis, u))).squaredNorm());
+    const Eigen::Vector3d d = Eigen::Vector3d(turned.row(g)) - ball.centre;
+    const double least =
+        ball.radius + skin.eye_clearance[static_cast<size_t>(v)] + kChordDip * grown / ball.radius + lid.clearance;
+    if (d.norm() < least) X.row(g) = (ball.centre + d.normalized() * least).transpose();
+  }
+  return Status::ok();
+}
+
 Expected<Pose> solve_pose(const FaceModel &model, const Activation &a, FactorCache *cache,
                           const PoseOptions &options) {
   const SkinModel &skin = model.tissue;
@@ -453,6 +524,22 @@ Expected<Pose> solve_pose(const FaceModel &model, const Activation &a, FactorCac
     join(set, model.jaw.dynamic.empty() ? model.jaw.vertices : model.jaw.dynamic);
   }
   const Eigen::MatrixXd reference = pose.X;  // the rest state, carried by the jaw
+  // Turned lids: the whole area turned by its shares is the first guess (a
+  // start given replaces it), the tarsus is placed and held.
+  std::vector<char> held;
+  std::vector<std::pair<int, Eigen::Vector3d>> placed;  // node, position
+  for (const LidTurn &lid : a.lids) {
+    Eigen::MatrixXd X = pose.X;
+    if (Status st = place_turned_lid(model, lid, X, &held); !st) return st;
+    const Muscle &m = model.muscles[static_cast<size_t>(lid.muscle)];
+    join(set, m.dynamic.empty() ? m.influence : m.dynamic);
+    for (int v : m.influence)
+      for (int l = 0; l < kSkull; ++l) {
+        const int g = skin.node(l, v);
+        pose.X.row(g) = X.row(g);
+        if (held[static_cast<size_t>(v)]) placed.emplace_back(g, X.row(g).transpose());
+      }
+  }
   if (const Pose *from = options.start) {
     // Its free nodes as the first guess; the skull nodes (fixed) stay this
     // pose's own, exactly.
@@ -467,13 +554,18 @@ Expected<Pose> solve_pose(const FaceModel &model, const Activation &a, FactorCac
         pose.X.row(g) = (on_jaw[static_cast<size_t>(v)] ? Eigen::Vector3d(carry * x) : x).transpose();
       }
   }
+  for (const auto &[g, x] : placed) pose.X.row(g) = x.transpose();
   if (set.empty() && !options.whole_mesh) return pose;
   const SolverOptions &opts = options.solver ? *options.solver : model.solver;
   FactorCache local;
   Status s = solve_growing(model, set, activation_forces(model, a.muscles), reference, pose.X, opts,
                            model.wave_threshold, cache ? cache : &local,
-                           options.whole_mesh, &pose.stats, &pose.rounds);
+                           options.whole_mesh, &pose.stats, &pose.rounds, nullptr, held.empty() ? nullptr : &held);
   if (!s) return s.wrap("pose");
+  std::vector<int> moved;  // the held vertices moved too
+  for (int v = 0; v < static_cast<int>(held.size()); ++v)
+    if (held[static_cast<size_t>(v)]) moved.push_back(v);
+  join(set, moved);
   pose.dynamic = std::move(set);
   return pose;
 }

@@ -99,9 +99,22 @@ struct FaceModel {
 Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &fdps,
                                      const FaceModelOptions &options);
 
+// A lid turned as a whole, about its driver's axis through the eyeball's
+// centre (the palpebral part of orbicularis oculi closing the lid's tarsal
+// plate, or levator palpebrae opening it).
+struct LidTurn {
+  int muscle = -1;       // a lid driver, index into FaceModel::muscles
+  double angle = 0;      // radians; positive closes
+  double clearance = 0;  // model units the tarsus's epidermis is held further off the eyeball (>= 0)
+};
+
 struct Activation {
   std::vector<std::pair<int, double>> muscles;  // (index into FaceModel::muscles, percent -100..100)
   double jaw_open = 0, jaw_thrust = 0, jaw_shift = 0;  // percent (open >= 0)
+  // Lids turned as a whole (place_turned_lid): the tarsus is placed and
+  // held there, the rest of the skin follows through the tissue. The lid
+  // driver's own load is not applied.
+  std::vector<LidTurn> lids;
 };
 
 struct Pose;
@@ -131,6 +144,17 @@ struct Pose {
 // unconverged pose.
 Expected<Pose> solve_pose(const FaceModel &model, const Activation &activation, FactorCache *cache,
                           const PoseOptions &options = {});
+
+// Where a lid turned as a whole (Activation::lids) puts the skin. X (4n x 3)
+// in: the unloaded state (the rest, or the rest carried by the jaw); out:
+// the lid's influence area turned about its axis, each vertex by the angle
+// times its Muscle::turn_share, and the tarsus's epidermis held off the
+// eyeball as the solver holds free skin (eye_clearance_in over the tarsus's
+// own edges) plus lid.clearance. Turning about the eyeball's centre keeps
+// the lid as far off the ball as at rest. *held (when given; sized to the
+// skin's vertices) gets the tarsus's vertices flagged. Fails for a muscle
+// that is not a lid driver with its eyeball.
+Status place_turned_lid(const FaceModel &model, const LidTurn &lid, Eigen::MatrixXd &X, std::vector<char> *held);
 
 // A quantity of a pose to steer (model units), adding its gradient (4n x 3)
 // to `gradient` when given; it must grow with the load.

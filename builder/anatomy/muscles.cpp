@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <limits>
 
 namespace afmb {
 
@@ -102,6 +103,9 @@ double turn(const Muscle &m, const Eigen::Vector3d &a, const Eigen::Vector3d &b)
 // Nodes nearer the axis than this share of the eyeball's radius get no lid
 // load: their pull would grow as 1 / rho.
 constexpr double kLidAxisFloor = 0.5;
+// The tarsus: the part of the lid's turn from the margin (alpha 0) to its
+// area's far edge that it spans.
+constexpr double kTarsusShare = 0.3;
 
 Status place_lid(const SkinModel &skin, const Eigen::Vector3d &outer, const Eigen::Vector3d &inner, Muscle &m) {
   m.force_layer = kEpidermis;
@@ -148,13 +152,57 @@ Status place_lid(const SkinModel &skin, const Eigen::Vector3d &outer, const Eige
   }
   double alpha_max = 0;
   for (double x : alpha) alpha_max = std::max(alpha_max, x);
+  // The opening the lid closes, across it: at each x, the turn from this
+  // lid's margin to the other lid's. A lid turned as a whole (face_model.h,
+  // place_turned_lid) turns each vertex by its x's share of the turn at a's
+  // x, so that the whole margin meets the other lid together; little toward
+  // the corners, where the lids meet at rest.
+  auto other_lid = [&](int v) {
+    if (!skin.in_mesh[static_cast<size_t>(v)]) return false;
+    const Eigen::Vector3d p = skin.X0.row(skin.node(kEpidermis, v));
+    return (p.y() - mid) * side < 0 && std::abs(p.x() - eye.centre.x()) < eye.radius &&
+           (p - eye.centre).norm() < 1.5 * eye.radius;
+  };
+  const std::vector<int> other = grow_region(skin, skin.vertex_of(m.node_b), other_lid);
+  // Only the skin over the eyeball (SkinModel::eye_of) bounds the opening:
+  // the margin's underside turns into the socket, further than the margin.
+  // Each margin is the envelope of its skin's turns, as points (x, turn):
+  // for this lid the highest of turn - K |x - x_v|, for the other the lowest
+  // of turn + K |x - x_v|, K one radian per sixth of the eyeball's radius:
+  // through the margin's vertices and linear between them, and continuous
+  // in x (a window's extremes jump as vertices enter it, and a jump in the
+  // share between two vertices of the margin turned one below the other).
+  auto over = [&](int v) { return skin.eye_of[static_cast<size_t>(v)] == m.eye; };
+  std::vector<Eigen::Vector2d> own_points, far_points;
+  for (size_t i = 0; i < area.size(); ++i)
+    if (over(area[i])) own_points.emplace_back(skin.X0(skin.node(kEpidermis, area[i]), 0), -alpha[i]);
+  for (int v : other) {
+    const Eigen::Vector3d p = skin.X0.row(skin.node(kEpidermis, v));
+    if (over(v)) far_points.emplace_back(p.x(), turn(m, oa.d, axis_offset(m, p).d));
+  }
+  const double slope = 6 / eye.radius;
+  auto gap = [&](double x) {  // NaN where either lid has no skin over the eyeball
+    double own = -std::numeric_limits<double>::infinity(), far = std::numeric_limits<double>::infinity();
+    for (const Eigen::Vector2d &q : own_points) own = std::max(own, q.y() - slope * std::abs(x - q.x()));
+    for (const Eigen::Vector2d &q : far_points) far = std::min(far, q.y() + slope * std::abs(x - q.x()));
+    return std::isfinite(own) && std::isfinite(far) ? far - own : std::numeric_limits<double>::quiet_NaN();
+  };
+  const double gap_a = gap(a.x());
+  m.closing_turn = std::isfinite(gap_a) ? std::max(gap_a, 0.0) : 0.0;
+  const double band = kTarsusShare * alpha_max;
   for (size_t i = 0; i < area.size(); ++i) {
     const double g = alpha[i] <= 0 ? 1.0 : std::pow(1 - alpha[i] / alpha_max, 4);
     const double q = across[i];
-    const double w = skin.area[area[i]] * g * std::cos(kHalfPi * q * q);
+    const double h = std::cos(kHalfPi * q * q);
+    const double w = skin.area[area[i]] * g * h;
     if (!(w > 0)) continue;
     m.influence.push_back(area[i]);
     m.weight.push_back(w);
+    const bool on_tarsus = alpha[i] <= band;
+    const double gx = gap(skin.X0(skin.node(kEpidermis, area[i]), 0));
+    const double share = !(gap_a > 0) ? 0.0 : std::isfinite(gx) ? std::clamp(gx / gap_a, 0.0, 1.0) : h;
+    m.tarsus.push_back(on_tarsus);
+    m.turn_share.push_back(on_tarsus ? share : share * std::pow(1 - (alpha[i] - band) / (alpha_max - band), 2));
   }
   return Status::ok();
 }
@@ -315,14 +363,19 @@ Expected<MouthLips> mouth_lips(const SkinModel &skin, const FdpSet &fdps) {
 
 void remove_from_influence(Muscle &m, const std::vector<int> &vertices) {
   std::vector<int> inf;
-  std::vector<double> w;
+  std::vector<double> w, share;
+  std::vector<char> tarsus;
+  const bool lid = !m.turn_share.empty();
   for (size_t i = 0; i < m.influence.size(); ++i)
     if (!std::binary_search(vertices.begin(), vertices.end(), m.influence[i])) {
       inf.push_back(m.influence[i]);
       w.push_back(m.weight[i]);
+      if (lid) share.push_back(m.turn_share[i]), tarsus.push_back(m.tarsus[i]);
     }
   m.influence = std::move(inf);
   m.weight = std::move(w);
+  m.turn_share = std::move(share);
+  m.tarsus = std::move(tarsus);
 }
 
 double muscle_load(const SkinModel &skin, const Muscle &m, double tension, const Eigen::MatrixXd &X,

@@ -89,6 +89,17 @@ struct Muscle {
   Eigen::Vector3d axis = Eigen::Vector3d::Zero();
   std::vector<int> influence;   // skin vertices, sorted
   std::vector<double> weight;   // per influence vertex
+  // Lid, per influence vertex: the share of the lid's turn it takes when the
+  // lid is turned as a whole (Activation::lids, face_model.h), 0..1, and
+  // whether it is on the tarsus: the stiff band along the margin (and the
+  // margin's underside), which turns rigidly with it and is held there;
+  // the rest of the lid follows through the tissue (its share is the first
+  // guess only).
+  std::vector<double> turn_share;
+  std::vector<char> tarsus;
+  // Lid: the turn (radians) that takes its margin at the key point to the
+  // other lid's margin at rest: the lids meet.
+  double closing_turn = 0;
   // Calibration (section 3.3): tension at +100 % and at -100 % contraction.
   double tension_max = 0, tension_min = 0;
   // The part of the table's range (max_fraction, min_fraction) that +-100 %

@@ -119,7 +119,7 @@ double eye_clearance_in(const SkinModel &m, int v, const Eigen::MatrixXd &X) {
   for (int u : m.neighbours[static_cast<size_t>(v)])
     if (m.eye_near[static_cast<size_t>(u)] == eye)
       grown = std::max(grown, (x - X.row(m.node(kEpidermis, u))).squaredNorm() - (x0 - m.X0.row(u)).squaredNorm());
-  return m.eye_clearance[static_cast<size_t>(v)] + grown / (8.0 * m.eyes[static_cast<size_t>(eye)].radius);
+  return m.eye_clearance[static_cast<size_t>(v)] + kChordDip * grown / m.eyes[static_cast<size_t>(eye)].radius;
 }
 
 std::vector<EyeSphere> fit_eyeballs(const Scene &scene) {
@@ -297,18 +297,21 @@ Expected<SkinModel> build_skin_model(const Scene &scene, int part, const TissueP
       m.skull_free[static_cast<size_t>(v)] = 1;
       m.eye_near[static_cast<size_t>(v)] = over;
     }
-    if (const int8_t e = m.eye_near[static_cast<size_t>(v)]; e >= 0) {
-      const EyeSphere &ball = m.eyes[static_cast<size_t>(e)];
-      const double rest = (p.V.row(v).transpose() - ball.centre).norm() - ball.radius;
-      // The skin between two held nodes is a chord: held at least its dip
-      // l^2 / (8 r) off, the longest edge's chord stays outside the ball.
-      double dip = 0;
-      for (int u : m.neighbours[static_cast<size_t>(v)])
-        dip = std::max(dip, (p.V.row(v) - p.V.row(u)).squaredNorm() / (8.0 * ball.radius));
-      m.eye_clearance[static_cast<size_t>(v)] = std::clamp(rest, 0.0, std::max(kEyeClearance * ball.radius, dip));
-    }
+    if (const int8_t e = m.eye_near[static_cast<size_t>(v)]; e >= 0) hold_off_eyeball(m, v, e);
   }
   return m;
+}
+
+void hold_off_eyeball(SkinModel &m, int v, int eye) {
+  const EyeSphere &ball = m.eyes[static_cast<size_t>(eye)];
+  const Eigen::RowVector3d p = m.X0.row(m.node(kEpidermis, v));
+  const double rest = (p.transpose() - ball.centre).norm() - ball.radius;
+  // The skin between held nodes dips toward the ball (kChordDip).
+  double dip = 0;
+  for (int u : m.neighbours[static_cast<size_t>(v)])
+    dip = std::max(dip, kChordDip * (p - m.X0.row(m.node(kEpidermis, u))).squaredNorm() / ball.radius);
+  m.eye_near[static_cast<size_t>(v)] = static_cast<int8_t>(eye);
+  m.eye_clearance[static_cast<size_t>(v)] = std::clamp(rest, 0.0, std::max(kEyeClearance * ball.radius, dip));
 }
 
 int nearest_node(const SkinModel &m, int layer, const Eigen::Vector3d &p) {

@@ -89,6 +89,13 @@ struct Spring {
 
 // The most a lid is held off its eyeball, in radii (SkinModel::eye_clearance).
 constexpr double kEyeClearance = 0.01;
+// Skin triangles whose corners are held h off a ball of radius r stay
+// outside it when h >= kChordDip l^2 / r, l the longest edge: the plane of
+// an acute triangle comes nearest the centre at its circumcentre, R^2 / (2 r)
+// below the corners, and R <= l / sqrt(3); an obtuse one at its longest
+// edge, l^2 / (8 r) below. With the edge's l^2 / (8 r) alone the 1k head's
+// lid, 10 mm triangles over a 12 mm eyeball, let the iris through when shut.
+constexpr double kChordDip = 1.0 / 6;
 
 // An eyeball the lids slide over: a sphere fitted to an eye part.
 struct EyeSphere {
@@ -147,7 +154,7 @@ struct SkinModel {
   std::vector<int8_t> eye_near;
   // Per vertex: how far off its eyeball's sphere the epidermal node is held
   // at rest (model units): its distance at rest, up to kEyeClearance radii or
-  // its longest edge's chord dip l^2 / (8 r), whichever is more. On the
+  // its longest edge's chord dip kChordDip l^2 / r, whichever is more. On the
   // sphere itself the skin between nodes, a chord, and the eye part's
   // vertices cross: Song's eyeball showed through the lid as dark specks.
   // In a pose it grows as the edges stretch (eye_clearance_in).
@@ -160,12 +167,17 @@ struct SkinModel {
   double stiffness(const Spring &s) const;
 };
 
+// Makes the solver hold vertex v's epidermal node off eyeball `eye`
+// (SkinModel::eye_near, with its eye_clearance: the rest distance up to
+// kEyeClearance radii or the longest edge's chord dip). X0 and neighbours
+// must be set.
+void hold_off_eyeball(SkinModel &m, int v, int eye);
+
 // How far off its eyeball's sphere the solver holds vertex v's epidermal
 // node in pose X (4n x 3; v must have eye_near[v] >= 0), model units:
 // eye_clearance[v] plus what the chords to its neighbours held by the same
-// eyeball dip further as they stretch, (l^2 - l0^2) / (8 r) for the longest
-// growth (two nodes held h off a ball of radius r keep their chord of length
-// l outside it when h >= l^2 / (8 r)). A closing lid stretches: on the 2k
+// eyeball dip further as they stretch, kChordDip (l^2 - l0^2) / r for the
+// longest growth. A closing lid stretches: on the 2k
 // head its triangles grew to 11 mm over a 12.2 mm eyeball, and held at their
 // rest clearance the eye part showed through them.
 double eye_clearance_in(const SkinModel &m, int v, const Eigen::MatrixXd &X);

@@ -168,6 +168,32 @@ const std::vector<FapContraction> &fap_group(const FaceModel &model, const FapMa
   return use_alt ? alt : own;
 }
 
+// An eyelid FAP's closing side made by turning its lid as a whole
+// (Activation::lids): where the model's lid driver of the FAP's own group
+// could not be calibrated to the table's range (its load turns the lid
+// only so far: the generated heads' lids open as wide as the iris, and
+// Newton found no equilibrium at their 50-degree turn), with the FDP's
+// vertex on its tarsus. muscle -1: not so; the driver's load makes it.
+struct LidFap {
+  int muscle = -1;
+  double share = 0;  // the FDP vertex's Muscle::turn_share
+};
+LidFap lid_fap(const FaceModel &model, const FapMapping &map, int side, int vertex) {
+  LidFap out;
+  if (!map.lid || side < 0 || map.positive.size() != 1) return out;
+  const int i = model.find(map.positive[0].muscle);
+  if (i < 0) return out;
+  const Muscle &m = model.muscles[static_cast<size_t>(i)];
+  if (m.kind != MuscleKind::Lid || m.turn_share.size() != m.influence.size() || !(m.range_max < 1)) return out;
+  const auto at = std::lower_bound(m.influence.begin(), m.influence.end(), vertex);
+  if (at == m.influence.end() || *at != vertex) return out;
+  const size_t k = static_cast<size_t>(at - m.influence.begin());
+  if (!m.tarsus[k] || !(m.turn_share[k] > 0)) return out;
+  out.muscle = i;
+  out.share = m.turn_share[k];
+  return out;
+}
+
 // Eyelid FAPs: weights the rows of D (#V x 3) by the lid's half (fap_mapping.h):
 // a smooth step in height across the lids' opening, 1 at the lid's centre.
 void keep_lid_half(const FaceModel &model, int fap, int lid, Eigen::MatrixXd &D) {
@@ -258,6 +284,48 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     if (sim) f.lifted_turned_faces = lifted_turned_faces(*sim, E - skin.X0.topRows(skin.n), &f.lifted_turned_share);
     return f;
   };
+
+  // How far the input's skin, lifted from a coarse displacement Dc (#Vc x
+  // 3), sinks below the clearance the solver would hold it at off the
+  // eyeball of lid driver `muscle` (skin_model.h, eye_clearance: its rest
+  // distance, up to the larger of kEyeClearance radii and its longest edge's
+  // chord dip), among its vertices bound to that lid's tarsus; model units,
+  // 0 when none does. Empty without a simulation mesh.
+  std::function<double(const Eigen::MatrixXd &, int)> lifted_eye;
+  if (sim) {
+    std::vector<uint8_t> used(static_cast<size_t>(sim->skin_V.rows()), 0);
+    for (Eigen::Index f = 0; f < sim->skin_F.rows(); ++f)
+      for (int j = 0; j < 3; ++j) used[static_cast<size_t>(sim->skin_F(f, j))] = 1;
+    const std::vector<int8_t> near = near_eyeballs(sim->skin_V, used, skin.eyes);
+    std::vector<double> longest(static_cast<size_t>(sim->skin_V.rows()), 0.0);
+    for (Eigen::Index f = 0; f < sim->skin_F.rows(); ++f)
+      for (int j = 0; j < 3; ++j) {
+        const int u = sim->skin_F(f, j), w = sim->skin_F(f, (j + 1) % 3);
+        const double l = (sim->skin_V.row(u) - sim->skin_V.row(w)).norm();
+        longest[static_cast<size_t>(u)] = std::max(longest[static_cast<size_t>(u)], l);
+        longest[static_cast<size_t>(w)] = std::max(longest[static_cast<size_t>(w)], l);
+      }
+    lifted_eye = [&model, &skin, sim, near, longest](const Eigen::MatrixXd &Dc, int muscle) {
+      const Muscle &m = model.muscles[static_cast<size_t>(muscle)];
+      std::vector<char> tarsus(static_cast<size_t>(skin.n), 0);
+      for (size_t k = 0; k < m.influence.size(); ++k) tarsus[static_cast<size_t>(m.influence[k])] = m.tarsus[k];
+      const EyeSphere &ball = skin.eyes[static_cast<size_t>(m.eye)];
+      const Eigen::MatrixXd E = sim->skin_V + lift_displacement(*sim, Dc);
+      double worst = 0;
+      for (Eigen::Index v = 0; v < E.rows(); ++v) {
+        if (near[static_cast<size_t>(v)] != m.eye) continue;
+        bool bound = false;
+        for (int j = 0; j < 3; ++j)
+          bound = bound || (sim->binding.weight(v, j) > 0 && tarsus[static_cast<size_t>(sim->binding.corner(v, j))]);
+        if (!bound) continue;
+        const double rest = (sim->skin_V.row(v).transpose() - ball.centre).norm() - ball.radius;
+        const double dip = kChordDip * longest[static_cast<size_t>(v)] * longest[static_cast<size_t>(v)] / ball.radius;
+        const double held = std::clamp(rest, 0.0, std::max(kEyeClearance * ball.radius, dip));
+        worst = std::max(worst, ball.radius + held - (E.row(v).transpose() - ball.centre).norm());
+      }
+      return worst;
+    };
+  }
 
   // The work list: a FAP's mapping and side, or a viseme's or an
   // expression's.
@@ -635,6 +703,92 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
           if (side > 0) res.control = c;
         }
       }
+    } else if (const LidFap lf = lid_fap(model, *map, side, fdp->vertex); lf.muscle >= 0) {
+      // A lid closing: its tarsus turned about the eyeball's centre until
+      // the FDP (on the margin, held with the tarsus) has come down by the
+      // value; the lid above follows through the tissue. The FDP's drop
+      // grows with the turn until the FDP passes under the centre; the turn
+      // is found by bisection on the placement itself.
+      const int node = skin.node(kEpidermis, fdp->vertex);
+      const Eigen::Vector3d along = side * dir;
+      LidTurn lid;
+      lid.muscle = lf.muscle;
+      auto moved = [&](double angle) {
+        Eigen::MatrixXd X = skin.X0;
+        lid.angle = angle;
+        if (!place_turned_lid(model, lid, X, nullptr)) return 0.0;
+        return (X.row(node) - skin.X0.row(node)).dot(along.transpose());
+      };
+      // The first of 180 steps of the turn, up to where the lids meet, at
+      // which the FDP has come down by the value, refined by bisection;
+      // else the step that takes it furthest (`most`).
+      double most = 0;
+      const Muscle &driver = model.muscles[static_cast<size_t>(lf.muscle)];
+      const double last = driver.closing_turn > 0 ? driver.closing_turn : M_PI / lf.share;
+      auto find_turn = [&] {
+        double lo = 0, best = 0;
+        most = -std::numeric_limits<double>::infinity();
+        for (int step = 1; step <= 180; ++step) {
+          const double t = step * last / 180;
+          const double d = moved(t);
+          if (d >= value) {
+            double hi = t;
+            for (int halving = 0; halving < 60; ++halving) {
+              const double mid = 0.5 * (lo + hi);
+              (moved(mid) < value ? lo : hi) = mid;
+            }
+            most = value;
+            return 0.5 * (lo + hi);
+          }
+          if (d > most) most = d, best = t;
+          lo = t;
+        }
+        return best;
+      };
+      FactorCache cache;
+      Expected<Pose> pz = Status::error("no pose");
+      // On a simulation mesh, the input's skin over the eyeball is lifted by
+      // blending its coarse triangle's corners' displacements: its offset
+      // from the coarse triangle does not turn with the lid, and where the
+      // lid has turned far, the lifted skin sinks toward the ball. One more
+      // round holds the tarsus further off by what it sank.
+      for (int round = 0; round < 2; ++round) {
+        lid.angle = find_turn();
+        Activation a;
+        a.lids.push_back(lid);
+        pz = solve_pose(model, a, &cache);
+        if (!pz || !lifted_eye) break;
+        const double sunk = lifted_eye(pose_epidermis(model, *pz) - skin.X0.topRows(skin.n), lf.muscle);
+        if (!(sunk > 0)) break;
+        lid.clearance += sunk;
+      }
+      o.scale = lid.angle;
+      const int met = static_cast<int>(std::floor(most / unit));  // FAP units where the lids meet
+      if (!pz) {
+        o.message = pz.status().message();
+      } else if (most < value && o.in_between && driver.closing_turn > 0 && met >= 1) {
+        // The lids meet short of the in-between's value: the target is the
+        // shut lid, at the value that shuts it (formats/afm.md: any
+        // references will do), so that a stream reaching it shows the lid
+        // shut and not a chord of the arc past it.
+        pose = std::move(*pz);
+        ok = true;
+        shrink = met * unit / most;
+        o.reference = side * met;
+        o.prescribed = side * met * unit * dir;
+        o.message = "the lids meet at " + std::to_string(met) + " (" +
+                    std::to_string(static_cast<int>(std::lround(100.0 * met / reference))) + " % of " +
+                    std::to_string(reference) + "): made there";
+      } else {
+        pose = std::move(*pz);
+        ok = true;
+        if (most < value) {
+          o.reached = std::max(most, 0.0) / value;
+          o.message = "reaches " + std::to_string(static_cast<int>(std::lround(100 * o.reached))) +
+                      " % of the prescribed motion: " +
+                      (driver.closing_turn > 0 ? "there the lids meet" : "the margin's arc over the eyeball goes no further");
+        }
+      }
     } else {
       std::vector<std::pair<int, double>> pattern;
       std::string missing;
@@ -868,6 +1022,22 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       r.target->number = work[k].fap->fap;
       r.target->reference = r.outcome.reference;
     }
+  }
+  // A FAP side's in-betweens go on past its nearer targets: one made at
+  // the value where the lids meet is dropped when that value is not past
+  // them (an eye opened less than a 600 in-between).
+  for (size_t k = 0; k < work.size(); ++k) {
+    if (!work[k].in_between || !results[k].target) continue;
+    int nearer = 0;
+    for (size_t j = 0; j < work.size(); ++j)
+      if (j != k && work[j].fap == work[k].fap && work[j].side == work[k].side && results[j].target &&
+          std::abs(results[j].outcome.reference) < work[k].reference)
+        nearer = std::max(nearer, std::abs(results[j].outcome.reference));
+    FapOutcome &o = results[k].outcome;
+    if (std::abs(o.reference) > nearer) continue;
+    results[k].target.reset();
+    o.made = false;
+    o.message += "; not kept: not past the side's target at " + std::to_string(nearer);
   }
   // FAP targets that move the same skin split it (fap_partition.h).
   {

@@ -25,6 +25,16 @@
 // player blends a side's targets piecewise linearly, so a lid follows its
 // arc over the eyeball up to there.
 //
+// An eyelid FAP's closing side whose lid driver was calibrated to less than
+// the table's range (the generated heads: no equilibrium at their lids'
+// 50-degree turn) turns the lid as a whole instead (face_model.h,
+// Activation::lids): the turn that brings the FDP down by the value, found
+// by bisection on the placement, up to the turn where the lids meet; an
+// in-between short of that is made at the value where they meet (its
+// reference), and dropped when that is not past the side's nearer target.
+// On a simulation mesh the tarsus is held further off the eyeball by what
+// the lifted skin over it sinks below its clearance, in one more solve.
+//
 // FAP targets that move the same skin (the inner and outer lip FAPs, the
 // midlip and mid-left/right ones, the brows, ...) then split it between
 // them (fap_partition.h), so that a stream sending them together moves each
@@ -130,7 +140,8 @@ struct FapOutcome {
   double largest = 0;             // the largest skin vertex displacement, model units
   double scale = 0;               // muscle groups: the factor on the table's contractions;
                                   // visemes and expressions: on the muscles the message
-                                  // names (1: the table's pose)
+                                  // names (1: the table's pose); a lid turned as a
+                                  // whole: its turn, radians; jaw FAPs: percent / 100
   int turned = 0;                 // skin triangles the target turns over (turned_faces), on
                                   // the input's skin once lifted (lift_synthesis)
   int dynamic = 0;                // vertices solved

@@ -640,7 +640,7 @@ TEST(Physics, TheLidsSlideOverTheEyeball) {
   // stretch (eye_clearance_in). On the 1k head's coarse lid that keeps the
   // edges' midpoints 0.46 mm into the ball, as at rest (edges at the margin
   // already cut it there; the nodes are held at most at their rest distance
-  // before they stretch), instead of 1.86 mm from 0.01 r off.
+  // before they stretch), instead of 1.67 mm from 0.01 r off.
   FaceModel thin = m;
   for (int v = 0; v < thin.tissue.n; ++v)
     if (const int e = thin.tissue.eye_near[static_cast<size_t>(v)]; e >= 0) {
@@ -664,6 +664,84 @@ TEST(Physics, TheLidsSlideOverTheEyeball) {
   std::fill(free.tissue.eye_near.begin(), free.tissue.eye_near.end(), int8_t(-1));
   const Eigen::MatrixXd Y = contract(free, "orbicularis_oculi_left", t);
   EXPECT_GT(deepest(Y), 0.05 * design.eye_radius) << "without the contact the lid goes into the eye";
+}
+
+// A lid turned as a whole (face_model.h, place_turned_lid): the turn that
+// shuts it is the one from its margin (FDP 3.1) to the other lid's (3.3)
+// about the eyeball's horizontal axis; the tarsus turns about the
+// eyeball's centre, so it comes no nearer the ball, and is held there; the
+// skin outside the lid stays put. Solved, the shut lid has 3.1 down at
+// 3.3's height and no lid skin inside the eyeball. A muscle that is not a
+// lid driver, or a negative clearance, is refused.
+TEST(Physics, ALidTurnedAsAWholeShutsOverTheEyeball) {
+  const FaceModel &m = head_1k().model;
+  const SkinModel &s = m.tissue;
+  const int i = m.find("palpebral_upper_left");
+  ASSERT_GE(i, 0);
+  const Muscle &lid = m.muscles[static_cast<size_t>(i)];
+  ASSERT_EQ(lid.turn_share.size(), lid.influence.size());
+  const EyeSphere &ball = s.eyes[static_cast<size_t>(lid.eye)];
+  const FdpPoint *upper = m.fdps.find(*FdpId::parse("3.1"), m.skin), *lower = m.fdps.find(*FdpId::parse("3.3"), m.skin);
+  ASSERT_TRUE(upper && lower);
+  auto yz = [&](int v) {
+    const Eigen::Vector3d d = s.X0.row(v).transpose() - ball.centre;
+    return std::atan2(d.y(), d.z());
+  };
+  const double opening = yz(upper->vertex) - yz(lower->vertex);
+  EXPECT_NEAR(lid.closing_turn, opening, 0.05 * opening);
+
+  LidTurn turn;
+  turn.muscle = i;
+  turn.angle = lid.closing_turn;
+  Eigen::MatrixXd X = s.X0;
+  std::vector<char> held;
+  ASSERT_TRUE(place_turned_lid(m, turn, X, &held).is_ok());
+  ASSERT_EQ(held.size(), static_cast<size_t>(s.n));
+  std::vector<char> in_lid(static_cast<size_t>(s.n), 0), tarsus(static_cast<size_t>(s.n), 0);
+  for (size_t k = 0; k < lid.influence.size(); ++k) {
+    in_lid[static_cast<size_t>(lid.influence[k])] = 1;
+    tarsus[static_cast<size_t>(lid.influence[k])] = lid.tarsus[k];
+  }
+  int on_tarsus = 0;
+  for (int v = 0; v < s.n; ++v) {
+    EXPECT_EQ(held[static_cast<size_t>(v)], tarsus[static_cast<size_t>(v)]) << v;
+    on_tarsus += tarsus[static_cast<size_t>(v)];
+    for (int l = 0; l < kSkull; ++l) {
+      const int g = s.node(l, v);
+      if (!in_lid[static_cast<size_t>(v)]) {
+        EXPECT_EQ(X.row(g), s.X0.row(g)) << v;
+      } else {
+        EXPECT_GE((X.row(g).transpose() - ball.centre).norm(), (s.X0.row(g).transpose() - ball.centre).norm() - 1e-12)
+            << v;
+      }
+    }
+  }
+  EXPECT_GT(on_tarsus, 3);
+
+  Activation a;
+  a.lids.push_back(turn);
+  FactorCache cache;
+  Expected<Pose> p = solve_pose(m, a, &cache);
+  ASSERT_TRUE(p.is_ok()) << p.status().message();
+  const Eigen::MatrixXd &P = p->X;
+  EXPECT_TRUE(P.allFinite());
+  EXPECT_NEAR(P(upper->vertex, 1), s.X0(lower->vertex, 1), 0.05 * m.fapu.irisd0) << "shut";
+  EXPECT_LE(deepest_in_eyes(m, P), 1e-9) << "no lid skin inside its eyeball";
+  // The skin between its nodes no deeper than at rest, where edges at the
+  // margin already cut the ball (Physics.TheLidsSlideOverTheEyeball).
+  EXPECT_LE(deepest_chord_in_eyes(m, P), deepest_chord_in_eyes(m, s.X0) + 0.02e-3);
+  for (int v = 0; v < s.n; ++v) {
+    if (!held[static_cast<size_t>(v)]) continue;
+    for (int l = 0; l < kSkull; ++l) EXPECT_EQ(P.row(s.node(l, v)), X.row(s.node(l, v))) << "held " << v;
+  }
+
+  LidTurn bad = turn;
+  bad.muscle = m.find("zygomaticus_major_left");
+  Eigen::MatrixXd Y = s.X0;
+  EXPECT_FALSE(place_turned_lid(m, bad, Y, nullptr).is_ok());
+  bad = turn;
+  bad.clearance = -1;
+  EXPECT_FALSE(place_turned_lid(m, bad, Y, nullptr).is_ok());
 }
 
 // The lid drivers (muscles.h) on Song's simulation mesh, as afm-build makes

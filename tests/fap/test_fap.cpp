@@ -25,6 +25,7 @@
 #include "anatomy/solver.h"
 #include "core/part_kind.h"
 #include "core/fapu.h"
+#include "core/ray_triangle.h"
 #include "fap/fap_mapping.h"
 #include "fap/fap_partition.h"
 #include "fap/fap_synthesis.h"
@@ -121,11 +122,13 @@ const Built &head_1k() {
   if (!b) {
     FaceModelOptions fo;
     // FAP 12's helpers (fap_mapping.cpp) too: zygomaticus minor, the upper
-    // lip, risorius and orbicularis oris; and nasalis for FAP 61, whose
-    // helpers are the upper lip and zygomaticus minor.
+    // lip, risorius and orbicularis oris; nasalis for FAP 61, whose helpers
+    // are the upper lip and zygomaticus minor; and the upper left lid's
+    // driver, which calibrates to half its range (FAP 19 then turns the lid
+    // as a whole).
     fo.calibrate_only = {"zygomaticus_major_left", "depressor_anguli_left", "frontalis_major_left", "corrugator_left",
                          "mentalis_left", "mentalis_right", "zygomaticus_minor_left", "upper_lip_left",
-                         "risorius_left", "orbicularis_oris", "nasalis_left"};
+                         "risorius_left", "orbicularis_oris", "nasalis_left", "palpebral_upper_left"};
     b = afmtest::build_reference_model(1000, fo);
   }
   return *b;
@@ -713,6 +716,127 @@ TEST(FapSynthesis, NoTargetFlipsASkinTriangleOrSinksIntoTheSkull) {
     EXPECT_EQ(flipped, 0);
     EXPECT_EQ(sunk, 0);
   }
+}
+
+// The generated head's neutral lids are tangent to the iris (MPEG-4's
+// neutral face), so FAP 19 at 1024 (one iris diameter, IRISD0) shuts the
+// upper lid: its in-between target there brings FDP 3.1 down to 3.3's
+// height, and the eye no longer shows, seen from the front, where it showed
+// at rest. The closing lid turns about the eyeball's centre (the lid driver
+// turned as a whole, face_model.h): its targets at 300, 600 and 1024, and
+// the player's blends between them, turn no skin triangle and put no skin
+// vertex into the eyeball. Through the driver's load the lid closed to 600
+// only, and 1024 was extrapolated (docs/notes.md).
+TEST(FapSynthesis, TheUpperLidShutsAtOneIrisDiameterOverTheEyeball) {
+  const Built &b = head_1k();
+  const FaceModel &m = b.model;
+  const SkinModel &s = m.tissue;
+  FapSynthesisOptions o;
+  o.only = {19};
+  Expected<FapSynthesis> syn = synthesize_faps(b.head.scene, m, o);
+  ASSERT_TRUE(syn.is_ok()) << syn.status().message();
+  std::map<int, const MorphTarget *> by;  // reference -> target
+  size_t next = 0;
+  for (const FapOutcome &out : syn->outcomes) {
+    if (!out.made) continue;
+    by[out.reference] = &syn->targets[next++];
+  }
+  for (int ref : {300, 600, 1024}) ASSERT_TRUE(by.count(ref)) << "FAP 19 at " << ref;
+  const Eigen::MatrixXd R = s.X0.topRows(s.n);
+  auto skin_at = [&](int ref) { return Eigen::MatrixXd(R + by[ref]->displacement[static_cast<size_t>(m.skin)]); };
+  const FdpPoint *upper = m.fdps.find(FdpId{3, 1}, m.skin), *lower = m.fdps.find(FdpId{3, 3}, m.skin);
+  ASSERT_TRUE(upper && lower);
+  const double irisd = m.fapu.irisd0;
+  // The MPEG-4 rule at each reference, down (-y).
+  for (int ref : {300, 600, 1024})
+    EXPECT_NEAR(R(upper->vertex, 1) - skin_at(ref)(upper->vertex, 1), ref * irisd / 1024, 4 * m.solver.tolerance)
+        << ref;
+  // Shut: 3.1 where 3.3 is, to a twentieth of the iris.
+  EXPECT_NEAR(skin_at(1024)(upper->vertex, 1), R(lower->vertex, 1), 0.05 * irisd);
+
+  // The left eye part's vertices on its front half that a ray toward the
+  // viewer (+z) takes past the skin: the eye seen from the front.
+  const int eye = b.head.scene.find_kind(PartKind::EyeLeft);
+  ASSERT_GE(eye, 0);
+  const Eigen::MatrixXd &E = b.head.scene.parts[static_cast<size_t>(eye)].V;
+  const double front = E.col(2).mean();
+  auto showing = [&](const Eigen::MatrixXd &X) {
+    int n = 0;
+    for (Eigen::Index v = 0; v < E.rows(); ++v) {
+      const Eigen::Vector3d p = E.row(v).transpose();
+      if (p.z() < front) continue;
+      bool hidden = false;
+      for (Eigen::Index f = 0; f < s.F.rows() && !hidden; ++f) {
+        double t = 0;
+        hidden = ray_triangle(p, Eigen::Vector3d::UnitZ(), X.row(s.F(f, 0)).transpose(), X.row(s.F(f, 1)).transpose(),
+                              X.row(s.F(f, 2)).transpose(), &t) &&
+                 t > 0;
+      }
+      n += !hidden;
+    }
+    return n;
+  };
+  const int open = showing(R), shut = showing(skin_at(1024));
+  std::printf("left eye vertices seen from the front: %d at rest, %d at 600, %d at 1024\n", open,
+              showing(skin_at(600)), shut);
+  EXPECT_GT(open, 20);
+  EXPECT_LE(shut, open / 20);
+
+  const std::vector<EyeSphere> balls = fit_eyeballs(b.head.scene);
+  ASSERT_FALSE(balls.empty());
+  // The deepest a skin vertex outside a ball at rest (within 1.5 radii) goes
+  // into it in skin X.
+  auto deepest = [&](const Eigen::MatrixXd &X) {
+    double d = -1;
+    for (const EyeSphere &e : balls)
+      for (int v = 0; v < s.n; ++v) {
+        const double rest = (R.row(v).transpose() - e.centre).norm();
+        if (!s.in_mesh[static_cast<size_t>(v)] || rest < e.radius || rest > 1.5 * e.radius) continue;
+        d = std::max(d, e.radius - (X.row(v).transpose() - e.centre).norm());
+      }
+    return d;
+  };
+  const Eigen::MatrixXd X300 = skin_at(300), X600 = skin_at(600), X1024 = skin_at(1024);
+  const std::vector<std::pair<const char *, Eigen::MatrixXd>> poses = {
+      {"300", X300}, {"450 (blended)", 0.5 * (X300 + X600)}, {"600", X600}, {"812 (blended)", 0.5 * (X600 + X1024)},
+      {"1024", X1024}};
+  for (const auto &[name, X] : poses) {
+    EXPECT_EQ(turned_over(R, s.F, X), 0) << name;
+    EXPECT_LE(deepest(X), m.quantum) << name;
+  }
+}
+
+// Where the lids meet short of an in-between's value (an eye opened less
+// than its iris: here the 1k head with IRISD0 taken 1.25 times its iris),
+// the in-between is made at the value that shuts the lid, and there the
+// FDP has come down by that value (the MPEG-4 rule) to the lower lid.
+TEST(FapSynthesis, WhereTheLidsMeetShortOfAnInBetweenItIsMadeWhereTheyMeet) {
+  const Built &b = head_1k();
+  FaceModel m = b.model;
+  m.fapu.irisd0 *= 1.25;
+  FapSynthesisOptions o;
+  o.only = {19};
+  Expected<FapSynthesis> syn = synthesize_faps(b.head.scene, m, o);
+  ASSERT_TRUE(syn.is_ok()) << syn.status().message();
+  const FapOutcome *shut = nullptr;
+  const MorphTarget *target = nullptr;
+  size_t next = 0;
+  for (const FapOutcome &out : syn->outcomes) {
+    if (!out.made) continue;
+    if (out.in_between && out.reference > 600) shut = &out, target = &syn->targets[next];
+    ++next;
+  }
+  ASSERT_NE(shut, nullptr) << "no in-between past 600";
+  // The opening is the iris, 1024 / 1.25 of the scaled unit.
+  EXPECT_NEAR(shut->reference, 1024 / 1.25, 1024 * 0.05);
+  EXPECT_LT(shut->reference, 1024);
+  EXPECT_EQ(target->reference, shut->reference);
+  const SkinModel &s = m.tissue;
+  const FdpPoint *upper = m.fdps.find(FdpId{3, 1}, m.skin), *lower = m.fdps.find(FdpId{3, 3}, m.skin);
+  ASSERT_TRUE(upper && lower);
+  const Eigen::MatrixXd &D = target->displacement[static_cast<size_t>(m.skin)];
+  EXPECT_NEAR(-D(upper->vertex, 1), shut->reference * m.fapu.irisd0 / 1024, 4 * m.solver.tolerance);
+  EXPECT_NEAR(s.X0(upper->vertex, 1) + D(upper->vertex, 1), s.X0(lower->vertex, 1), 0.05 * b.model.fapu.irisd0);
 }
 
 // The check that stops a group's extrapolation (face_model.h) sees a fold
