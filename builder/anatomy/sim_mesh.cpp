@@ -160,6 +160,150 @@ std::vector<int> mirror_vertices(const Part &skin, double mid, double tolerance)
   return out;
 }
 
+// OpenMesh's decimater (the same modules, priorities and legality) with
+// each collapse made together with its mirror image: the collapse of the
+// images of its two vertices (`mirror`, one entry per vertex, -1 for none),
+// so that a mirror-symmetric skin keeps a mirror-symmetric simulation mesh.
+// A collapse is legal only with its image: none moves a vertex of the
+// mid-plane off it or joins a vertex to its own image, and one with an image
+// needs the image's collapse legal too (re-checked after the first; a
+// region without images collapses alone). Ties between equal priorities go
+// to the lower vertex index.
+class MirroredDecimater : public OpenMesh::Decimater::BaseDecimaterT<TriMesh> {
+ public:
+  using Base = OpenMesh::Decimater::BaseDecimaterT<TriMesh>;
+  MirroredDecimater(TriMesh &mesh, std::vector<int> mirror) : Base(mesh), mesh_(mesh), mirror_(std::move(mirror)) {}
+
+  // Collapses until at most `target` vertices are left or no collapse is
+  // legal. Returns the collapses made; *unpaired gets those whose image
+  // could not follow.
+  size_t decimate_to(size_t target, size_t *unpaired) {
+    const size_t n = mesh_.n_vertices();
+    best_.assign(n, TriMesh::HalfedgeHandle());
+    stamp_.assign(n, 0);
+    for (TriMesh::VertexHandle v : mesh_.vertices()) heap(v);
+    size_t alive = n, made = 0;
+    *unpaired = 0;
+    while (alive > target && !queue_.empty()) {
+      const Entry e = queue_.top();
+      queue_.pop();
+      const TriMesh::VertexHandle v(e.vertex);
+      if (e.stamp != stamp_[static_cast<size_t>(e.vertex)] || mesh_.status(v).deleted()) continue;
+      const TriMesh::HalfedgeHandle h = best_[static_cast<size_t>(e.vertex)];
+      float p = 0;
+      TriMesh::HalfedgeHandle image;
+      if (!h.is_valid() || !legal(h, &p, &image)) {
+        heap(v);
+        continue;
+      }
+      std::vector<TriMesh::VertexHandle> support;
+      const int m0 = image.is_valid() ? mesh_.from_vertex_handle(image).idx() : -1;
+      const int m1 = image.is_valid() ? mesh_.to_vertex_handle(image).idx() : -1;
+      collapse(h, support);
+      ++made, --alive;
+      if (m0 >= 0 && alive > target) {
+        const TriMesh::HalfedgeHandle again =
+            mesh_.find_halfedge(TriMesh::VertexHandle(m0), TriMesh::VertexHandle(m1));
+        CollapseInfo ci(mesh_, again);
+        if (again.is_valid() && this->is_collapse_legal(ci) && this->collapse_priority(ci) >= 0) {
+          collapse(again, support);
+          ++made, --alive;
+        } else {
+          ++*unpaired;
+        }
+      }
+      for (TriMesh::VertexHandle u : support)
+        if (!mesh_.status(u).deleted()) heap(u);
+    }
+    return made;
+  }
+
+ private:
+  struct Entry {
+    float priority;
+    int vertex;
+    unsigned stamp;
+    bool operator<(const Entry &o) const {  // std::priority_queue pops the largest
+      return priority != o.priority ? priority > o.priority : vertex > o.vertex;
+    }
+  };
+
+  int image_of(int v) const { return v >= 0 && static_cast<size_t>(v) < mirror_.size() ? mirror_[v] : -1; }
+
+  // Whether collapsing h is legal alone (*priority: its priority).
+  bool legal_alone(TriMesh::HalfedgeHandle h, float *priority) {
+    CollapseInfo ci(mesh_, h);
+    if (!this->is_collapse_legal(ci)) return false;
+    *priority = this->collapse_priority(ci);
+    return *priority >= 0;
+  }
+
+  // Whether collapsing h is legal with its image (*image: the image's
+  // halfedge, invalid when it collapses alone); *priority its priority.
+  bool legal(TriMesh::HalfedgeHandle h, float *priority, TriMesh::HalfedgeHandle *image) {
+    *image = TriMesh::HalfedgeHandle();
+    return legal_alone(h, priority) && pair_legal(h, image);
+  }
+
+  // The image's part of legal(), for an h legal alone.
+  bool pair_legal(TriMesh::HalfedgeHandle h, TriMesh::HalfedgeHandle *image) {
+    *image = TriMesh::HalfedgeHandle();
+    const int v0 = mesh_.from_vertex_handle(h).idx(), v1 = mesh_.to_vertex_handle(h).idx();
+    const int m0 = image_of(v0), m1 = image_of(v1);
+    if (m0 < 0 && m1 < 0) return true;       // no images here: alone
+    if (m0 < 0 || m1 < 0) return false;       // half a pair
+    if (m0 == v1 && m1 == v0) return false;   // a vertex onto its own image
+    if (m0 == v0) return m1 == v1;            // on the mid-plane: alone, and stays on it
+    const TriMesh::HalfedgeHandle hm = mesh_.find_halfedge(TriMesh::VertexHandle(m0), TriMesh::VertexHandle(m1));
+    if (!hm.is_valid()) return false;
+    CollapseInfo cm(mesh_, hm);
+    if (!this->is_collapse_legal(cm) || this->collapse_priority(cm) < 0) return false;
+    *image = hm;
+    return true;
+  }
+
+  void collapse(TriMesh::HalfedgeHandle h, std::vector<TriMesh::VertexHandle> &support) {
+    CollapseInfo ci(mesh_, h);
+    for (TriMesh::VertexHandle u : mesh_.vv_range(ci.v0)) support.push_back(u);
+    this->preprocess_collapse(ci);
+    mesh_.collapse(h);
+    for (TriMesh::FaceHandle f : mesh_.vf_range(ci.v1))
+      if (!mesh_.status(f).deleted()) mesh_.set_normal(f, mesh_.calc_face_normal(f));
+    this->postprocess_collapse(ci);
+  }
+
+  // v's best legal collapse, queued (or none). The image is checked in
+  // order of priority, until one passes: the image's check costs as much as
+  // the collapse's own.
+  void heap(TriMesh::VertexHandle v) {
+    const size_t i = static_cast<size_t>(v.idx());
+    std::vector<std::pair<float, int>> alone;  // priority, halfedge index
+    for (TriMesh::HalfedgeHandle h : mesh_.voh_range(v)) {
+      float p = 0;
+      if (legal_alone(h, &p)) alone.emplace_back(p, h.idx());
+    }
+    std::sort(alone.begin(), alone.end());
+    TriMesh::HalfedgeHandle target;
+    float best = 0;
+    for (const auto &[p, h] : alone) {
+      TriMesh::HalfedgeHandle image;
+      if (pair_legal(TriMesh::HalfedgeHandle(h), &image)) {
+        best = p, target = TriMesh::HalfedgeHandle(h);
+        break;
+      }
+    }
+    best_[i] = target;
+    ++stamp_[i];
+    if (target.is_valid()) queue_.push(Entry{best, v.idx(), stamp_[i]});
+  }
+
+  TriMesh &mesh_;
+  std::vector<int> mirror_;
+  std::vector<TriMesh::HalfedgeHandle> best_;
+  std::vector<unsigned> stamp_;
+  std::priority_queue<Entry> queue_;
+};
+
 // For every skin vertex, the kept vertex nearest along the skin's edges
 // (-1 where none is reachable), by Dijkstra from all kept vertices at once.
 std::vector<int> nearest_kept(const Part &skin, const std::vector<int> &kept) {
@@ -311,15 +455,15 @@ Expected<SimMesh> make_sim_mesh(const Scene &scene, const FdpSet &fdps, const Si
   const double es0 = has_l && has_r ? (eye_l - eye_r).norm() : 0.1 * (hi - lo).norm();
   const double reach = kFeatureReach * es0;
 
-  // A mirror-symmetric skin gets a mirror-symmetric simulation mesh, as far
-  // as the decimater allows. It chooses among collapses by priority and
-  // breaks ties by handle order; Song's FDPs are a few hundredths off
-  // symmetric, and its left eye came out a sixth coarser than its right (55
-  // against 63 vertices within 20 units of the pupils), its eye sphincter
-  // with a smaller influence and a narrower range. So, when nine in ten skin
-  // vertices have a mirror image: the FDPs' vertices lock their images too,
-  // the sizing sees the features and their images, and the priority breaks
-  // ties by a function of the far end that the mirror keeps.
+  // A mirror-symmetric skin gets a mirror-symmetric simulation mesh. Song's
+  // FDPs are a few hundredths off symmetric, and OpenMesh's decimater breaks
+  // ties by handle order: its left eye came out a sixth coarser than its
+  // right (55 against 63 vertices within 20 units of the pupils), its eye
+  // sphincter with a smaller influence and a narrower range. So, when nine in
+  // ten skin vertices have a mirror image: the FDPs' vertices lock their
+  // images too, the sizing sees the features and their images, the priority
+  // breaks ties by a function of the far end that the mirror keeps, and the
+  // collapses are made in mirror pairs (MirroredDecimater).
   double mid = 0;
   std::vector<int> mirror;
   if (has_l && has_r) {
@@ -370,8 +514,7 @@ Expected<SimMesh> make_sim_mesh(const Scene &scene, const FdpSet &fdps, const Si
   keep_lips(mesh, skin, lips, kLipKeep * es0, options.vertices / 2);
   keep_lids(mesh, skin, fit_eyeballs(scene));
 
-  using Decimater = OpenMesh::Decimater::DecimaterT<TriMesh>;
-  Decimater dec(mesh);
+  MirroredDecimater dec(mesh, mirror);
   ModSizedLengthT<TriMesh>::Handle length;
   OpenMesh::Decimater::ModNormalDeviationT<TriMesh>::Handle normal;
   OpenMesh::Decimater::ModHausdorffT<TriMesh>::Handle distance;
@@ -395,13 +538,16 @@ Expected<SimMesh> make_sim_mesh(const Scene &scene, const FdpSet &fdps, const Si
   dec.module(aspect).set_aspect_ratio(kMaxAspectRatio);
   dec.module(aspect).set_binary(true);
   if (!dec.initialize()) return identity();
-  dec.decimate_to(static_cast<size_t>(options.vertices));
+  size_t unpaired = 0;
+  dec.decimate_to(static_cast<size_t>(options.vertices), &unpaired);
 
   // The survivors, in skin order, and their triangles (no garbage
   // collection: a handle's index is still its skin vertex).
   SimMesh sim;
   sim.skin = skin_index;
   sim.decimated = true;
+  sim.mirrored = !mirror.empty();
+  sim.unpaired = static_cast<int>(unpaired);
   std::vector<int> coarse_of(static_cast<size_t>(n), -1);
   for (int v = 0; v < n; ++v)
     if (!mesh.status(vh[static_cast<size_t>(v)]).deleted()) {

@@ -5,6 +5,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -386,17 +387,65 @@ Eigen::Vector3d pupil(const FdpSet &fdps, int index) { return fdps.find(FdpId{3,
 }  // namespace
 
 // A mirror-symmetric skin is decimated into a mirror-symmetric simulation
-// mesh, as far as the decimater allows (sim_mesh.cpp).
+// mesh, collapses made in mirror pairs (sim_mesh.cpp): every coarse vertex
+// has its image among them, and the coarse triangles whose image is not a
+// coarse triangle are at most the skin's own such. OpenMesh's decimater alone, even with mirror-invariant ties,
+// left 8 of the 2k head's 700 coarse vertices without an image (45 and 49
+// within 0.6 eye separations of the pupils), and the 10k head's FAP 42 41 %
+// off its direction where 41 was 15 % (docs/notes.md).
 TEST(SimMesh, AMirrorSymmetricSkinKeepsMirrorImages) {
   const RefHead &h = head_2k();
   const Part &skin = h.scene.parts[static_cast<size_t>(h.scene.find_kind(PartKind::Skin))];
+  const SimMesh &sim = sim_700();
   const Eigen::Vector3d l = pupil(h.fdps, 5), r = pupil(h.fdps, 6);
-  const Symmetry s = symmetry(skin, sim_700(), l, r, 0.6 * (l - r).norm());
+  const Symmetry s = symmetry(skin, sim, l, r, 0.6 * (l - r).norm());
   std::printf("2k head at 700: %.3f mirrored, %d and %d near the pupils\n", s.mirrored, s.near_left, s.near_right);
-  EXPECT_GE(s.mirrored, 0.9);
-  // Within a tenth: 45 and 49 since the generator's lid rows (0.989
-  // mirrored: about eight of the 700 coarse vertices have no image).
-  EXPECT_LE(std::abs(s.near_left - s.near_right), 0.1 * (s.near_left + s.near_right) / 2);
+  EXPECT_TRUE(sim.mirrored);
+  EXPECT_EQ(sim.unpaired, 0);
+  EXPECT_EQ(s.mirrored, 1.0);
+  EXPECT_EQ(s.near_left, s.near_right);
+  // The coarse vertex at each coarse vertex's image, by position.
+  const double mid = 0.5 * (l.x() + r.x()), tol = 1e-3 * (l - r).norm();
+  std::vector<int> image(static_cast<size_t>(sim.V.rows()), -1);
+  for (Eigen::Index c = 0; c < sim.V.rows(); ++c) {
+    Eigen::Vector3d p = sim.V.row(c).transpose();
+    p.x() = 2 * mid - p.x();
+    for (Eigen::Index d = 0; d < sim.V.rows(); ++d)
+      if ((sim.V.row(d).transpose() - p).norm() < tol) image[static_cast<size_t>(c)] = static_cast<int>(d);
+  }
+  std::set<std::array<int, 3>> triangles;
+  auto sorted = [](int a, int b, int c) {
+    std::array<int, 3> t{a, b, c};
+    std::sort(t.begin(), t.end());
+    return t;
+  };
+  for (Eigen::Index f = 0; f < sim.F.rows(); ++f) triangles.insert(sorted(sim.F(f, 0), sim.F(f, 1), sim.F(f, 2)));
+  int without = 0;
+  for (Eigen::Index f = 0; f < sim.F.rows(); ++f) {
+    const int a = image[static_cast<size_t>(sim.F(f, 0))], b = image[static_cast<size_t>(sim.F(f, 1))],
+              c = image[static_cast<size_t>(sim.F(f, 2))];
+    without += a < 0 || b < 0 || c < 0 || !triangles.count(sorted(a, b, c));
+  }
+  // The skin's own: a few of its triangles' images are not triangles (a
+  // quad split the same way on both sides).
+  std::vector<int> skin_image(static_cast<size_t>(skin.V.rows()), -1);
+  std::set<std::array<int, 3>> skin_triangles;
+  for (Eigen::Index f = 0; f < skin.F.rows(); ++f) skin_triangles.insert(sorted(skin.F(f, 0), skin.F(f, 1), skin.F(f, 2)));
+  for (Eigen::Index v = 0; v < skin.V.rows(); ++v) {
+    Eigen::Vector3d p = skin.V.row(v).transpose();
+    p.x() = 2 * mid - p.x();
+    for (Eigen::Index u = 0; u < skin.V.rows(); ++u)
+      if ((skin.V.row(u).transpose() - p).norm() < tol) skin_image[static_cast<size_t>(v)] = static_cast<int>(u);
+  }
+  int skin_without = 0;
+  for (Eigen::Index f = 0; f < skin.F.rows(); ++f) {
+    const int a = skin_image[static_cast<size_t>(skin.F(f, 0))], b = skin_image[static_cast<size_t>(skin.F(f, 1))],
+              c = skin_image[static_cast<size_t>(skin.F(f, 2))];
+    skin_without += a < 0 || b < 0 || c < 0 || !skin_triangles.count(sorted(a, b, c));
+  }
+  std::printf("triangles whose image is not one: %d of the skin's %lld, %d of the coarse mesh's %lld\n", skin_without,
+              static_cast<long long>(skin.F.rows()), without, static_cast<long long>(sim.F.rows()));
+  EXPECT_LE(without, skin_without) << "coarse triangles whose image is not one, beyond the skin's own";
 }
 
 // Song's skin is mirror-symmetric (nine in ten vertices have an image within
@@ -412,8 +461,12 @@ TEST(SimMesh, SongsEyesAreDecimatedAlike) {
   const FdpSet &fdps = song.face.fdps;
   const Part &skin = song.face.scene.parts[static_cast<size_t>(sim.skin)];
   const Symmetry s = symmetry(skin, sim, pupil(fdps, 5), pupil(fdps, 6), 20);
-  std::printf("Song at 1000: %.3f mirrored, %d and %d near the pupils\n", s.mirrored, s.near_left, s.near_right);
-  EXPECT_GE(s.mirrored, 0.9);
+  std::printf("Song at 1000: %.3f mirrored, %d and %d near the pupils, %d collapses unpaired\n", s.mirrored,
+              s.near_left, s.near_right, sim.unpaired);
+  // 0.936 before the collapses were made in mirror pairs; Song's skin has
+  // vertices without an image (its FDPs are a few hundredths off symmetric).
+  EXPECT_TRUE(sim.mirrored);
+  EXPECT_GE(s.mirrored, 0.98);
   EXPECT_LE(std::abs(s.near_left - s.near_right), 2);
 }
 

@@ -1600,7 +1600,8 @@ struct SongOnSimMesh {
   LoadedFace face;
   SimFaceModel built;
 };
-SongOnSimMesh song_on_sim_mesh(const std::vector<std::string> &muscles, bool jaw = false) {
+SongOnSimMesh song_on_sim_mesh(const std::vector<std::string> &muscles, bool jaw = false,
+                               int vertices = kDefaultSimVertices) {
   SongOnSimMesh out;
   Expected<LoadedFace> f = load_face(afmtest::shared_data("faces/song/song.WRL"),
                                      afmtest::shared_data("faces/song/song.fdp"), LoadOptions{}, nullptr);
@@ -1612,7 +1613,7 @@ SongOnSimMesh song_on_sim_mesh(const std::vector<std::string> &muscles, bool jaw
   fo.calibrate_muscles = !muscles.empty();
   fo.calibrate_jaw = jaw;
   Expected<SimFaceModel> m =
-      build_sim_face_model(out.face.scene, out.face.fdps, SimMeshOptions{kDefaultSimVertices}, fo);
+      build_sim_face_model(out.face.scene, out.face.fdps, SimMeshOptions{vertices}, fo);
   EXPECT_TRUE(m.is_ok()) << m.status().message();
   if (m.is_ok()) out.built = std::move(*m);
   return out;
@@ -1729,7 +1730,10 @@ TEST(FapSynthesis, SongsLidsCloseOverTheEyeballInBetweenTargetsIncluded) {
 // of a coarse one (fap_synthesis.h).
 TEST(FapSynthesis, ATargetMadeOnASimulationMeshDoesNotFoldTheLiftedSkin) {
   AFM_REQUIRE_SHARED_DATA();
-  const SongOnSimMesh song = song_on_sim_mesh({"orbicularis_oris"});
+  // On an 800-vertex mesh: on afm-build's 1,000, decimated in mirror pairs
+  // since the thirty-fourth session, none of Song's mouth FAPs folds the
+  // lifted skin and not the coarse one.
+  const SongOnSimMesh song = song_on_sim_mesh({"orbicularis_oris"}, false, 800);
   ASSERT_FALSE(HasFailure());
   const SimFaceModel &sm = song.built;
   ASSERT_TRUE(sm.sim.decimated);
