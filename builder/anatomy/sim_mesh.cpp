@@ -189,10 +189,12 @@ class MirroredDecimater : public OpenMesh::Decimater::BaseDecimaterT<TriMesh> {
       queue_.pop();
       const TriMesh::VertexHandle v(e.vertex);
       if (e.stamp != stamp_[static_cast<size_t>(e.vertex)] || mesh_.status(v).deleted()) continue;
+      // As OpenMesh's decimater: the queued collapse's topology again (the
+      // modules' verdicts were renewed with every change around it), and
+      // its image's.
       const TriMesh::HalfedgeHandle h = best_[static_cast<size_t>(e.vertex)];
-      float p = 0;
       TriMesh::HalfedgeHandle image;
-      if (!h.is_valid() || !legal(h, &p, &image)) {
+      if (!h.is_valid() || !this->is_collapse_legal(CollapseInfo(mesh_, h)) || !pair_legal(h, &image)) {
         heap(v);
         continue;
       }
@@ -212,6 +214,8 @@ class MirroredDecimater : public OpenMesh::Decimater::BaseDecimaterT<TriMesh> {
           ++*unpaired;
         }
       }
+      std::sort(support.begin(), support.end());
+      support.erase(std::unique(support.begin(), support.end()), support.end());
       for (TriMesh::VertexHandle u : support)
         if (!mesh_.status(u).deleted()) heap(u);
     }
@@ -238,14 +242,8 @@ class MirroredDecimater : public OpenMesh::Decimater::BaseDecimaterT<TriMesh> {
     return *priority >= 0;
   }
 
-  // Whether collapsing h is legal with its image (*image: the image's
-  // halfedge, invalid when it collapses alone); *priority its priority.
-  bool legal(TriMesh::HalfedgeHandle h, float *priority, TriMesh::HalfedgeHandle *image) {
-    *image = TriMesh::HalfedgeHandle();
-    return legal_alone(h, priority) && pair_legal(h, image);
-  }
-
-  // The image's part of legal(), for an h legal alone.
+  // Whether h's image may collapse with it (*image: the image's halfedge,
+  // invalid when h collapses alone), for an h legal alone.
   bool pair_legal(TriMesh::HalfedgeHandle h, TriMesh::HalfedgeHandle *image) {
     *image = TriMesh::HalfedgeHandle();
     const int v0 = mesh_.from_vertex_handle(h).idx(), v1 = mesh_.to_vertex_handle(h).idx();
