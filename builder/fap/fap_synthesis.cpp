@@ -168,12 +168,9 @@ const std::vector<FapContraction> &fap_group(const FaceModel &model, const FapMa
   return use_alt ? alt : own;
 }
 
-// An eyelid FAP's closing side made by turning its lid as a whole
-// (Activation::lids): where the model's lid driver of the FAP's own group
-// could not be calibrated to the table's range (its load turns the lid
-// only so far: the generated heads' lids open as wide as the iris, and
-// Newton found no equilibrium at their 50-degree turn), with the FDP's
-// vertex on its tarsus. muscle -1: not so; the driver's load makes it.
+// An eyelid FAP's closing side can be made by turning its lid as a whole
+// (Activation::lids): the lid driver of the FAP's own group, where the model
+// has it with the FDP's vertex on its tarsus; muscle -1: not so.
 struct LidFap {
   int muscle = -1;
   double share = 0;  // the FDP vertex's Muscle::turn_share
@@ -184,7 +181,7 @@ LidFap lid_fap(const FaceModel &model, const FapMapping &map, int side, int vert
   const int i = model.find(map.positive[0].muscle);
   if (i < 0) return out;
   const Muscle &m = model.muscles[static_cast<size_t>(i)];
-  if (m.kind != MuscleKind::Lid || m.turn_share.size() != m.influence.size() || !(m.range_max < 1)) return out;
+  if (m.kind != MuscleKind::Lid || m.turn_share.size() != m.influence.size()) return out;
   const auto at = std::lower_bound(m.influence.begin(), m.influence.end(), vertex);
   if (at == m.influence.end() || *at != vertex) return out;
   const size_t k = static_cast<size_t>(at - m.influence.begin());
@@ -630,6 +627,103 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     Pose pose;
     bool ok = false;
     double shrink = 1;  // on the target, when a capped pose lies just beyond the value
+    // A closing lid turned as a whole (lid_fap). Where the driver could not
+    // be calibrated to the table's range (its load turns the lid only so
+    // far: the generated heads' lids open as wide as the iris, and Newton
+    // found no equilibrium at their 50-degree turn), for every closing
+    // target; elsewhere for an in-between the driver's load does not reach,
+    // kept only where the skin stays a face.
+    const LidFap lid = fdp && fdp->part == model.skin && fdp->vertex >= 0 ? lid_fap(model, *map, side, fdp->vertex)
+                                                                           : LidFap();
+    const bool lid_cut = lid.muscle >= 0 && model.muscles[static_cast<size_t>(lid.muscle)].range_max < 1;
+    // The tarsus turned about the eyeball's centre until the FDP (on the
+    // margin, held with the tarsus) has come down by the value; the lid
+    // above follows through the tissue. The FDP's drop grows with the turn
+    // until the FDP passes under the centre; the turn is found by bisection
+    // on the placement itself. Whether a pose was made (into `pose`, with
+    // `o` and `shrink`).
+    auto turn_lid = [&](const LidFap &lf) -> bool {
+      const int node = skin.node(kEpidermis, fdp->vertex);
+      const Eigen::Vector3d along = side * dir;
+      LidTurn turn;
+      turn.muscle = lf.muscle;
+      auto moved = [&](double angle) {
+        Eigen::MatrixXd X = skin.X0;
+        turn.angle = angle;
+        if (!place_turned_lid(model, turn, X, nullptr)) return 0.0;
+        return (X.row(node) - skin.X0.row(node)).dot(along.transpose());
+      };
+      // The first of 180 steps of the turn, up to where the lids meet, at
+      // which the FDP has come down by the value, refined by bisection;
+      // else the step that takes it furthest (`most`).
+      double most = 0;
+      const Muscle &driver = model.muscles[static_cast<size_t>(lf.muscle)];
+      const double last = driver.closing_turn > 0 ? driver.closing_turn : M_PI / lf.share;
+      auto find_turn = [&] {
+        double lo = 0, best = 0;
+        most = -std::numeric_limits<double>::infinity();
+        for (int step = 1; step <= 180; ++step) {
+          const double t = step * last / 180;
+          const double d = moved(t);
+          if (d >= value) {
+            double hi = t;
+            for (int halving = 0; halving < 60; ++halving) {
+              const double mid = 0.5 * (lo + hi);
+              (moved(mid) < value ? lo : hi) = mid;
+            }
+            most = value;
+            return 0.5 * (lo + hi);
+          }
+          if (d > most) most = d, best = t;
+          lo = t;
+        }
+        return best;
+      };
+      FactorCache cache;
+      Expected<Pose> pz = Status::error("no pose");
+      // On a simulation mesh, the input's skin over the eyeball is lifted by
+      // blending its coarse triangle's corners' displacements: its offset
+      // from the coarse triangle does not turn with the lid, and where the
+      // lid has turned far, the lifted skin sinks toward the ball. One more
+      // round holds the tarsus further off by what it sank.
+      for (int round = 0; round < 2; ++round) {
+        turn.angle = find_turn();
+        Activation a;
+        a.lids.push_back(turn);
+        pz = solve_pose(model, a, &cache);
+        if (!pz || !lifted_eye) break;
+        const double sunk = lifted_eye(pose_epidermis(model, *pz) - skin.X0.topRows(skin.n), lf.muscle);
+        if (!(sunk > 0)) break;
+        turn.clearance += sunk;
+      }
+      o.scale = turn.angle;
+      const int met = static_cast<int>(std::floor(most / unit));  // FAP units where the lids meet
+      if (!pz) {
+        o.message = pz.status().message();
+        return false;
+      }
+      pose = std::move(*pz);
+      o.reached = 1;
+      o.message.clear();
+      if (most < value && o.in_between && driver.closing_turn > 0 && met >= 1) {
+        // The lids meet short of the in-between's value: the target is the
+        // shut lid, at the value that shuts it (formats/afm.md: any
+        // references will do), so that a stream reaching it shows the lid
+        // shut and not a chord of the arc past it.
+        shrink = met * unit / most;
+        o.reference = side * met;
+        o.prescribed = side * met * unit * dir;
+        o.message = "the lids meet at " + std::to_string(met) + " (" +
+                    std::to_string(static_cast<int>(std::lround(100.0 * met / reference))) + " % of " +
+                    std::to_string(reference) + "): made there";
+      } else if (most < value) {
+        o.reached = std::max(most, 0.0) / value;
+        o.message = "reaches " + std::to_string(static_cast<int>(std::lround(100 * o.reached))) +
+                    " % of the prescribed motion: " +
+                    (driver.closing_turn > 0 ? "there the lids meet" : "the margin's arc over the eyeball goes no further");
+      }
+      return true;
+    };
     if (!fdp || fdp->part != model.skin || fdp->vertex < 0) {
       o.message = "its FDP " + std::to_string(info->fdp_group) + "." + std::to_string(info->fdp_index) +
                   " is not on the skin";
@@ -703,92 +797,8 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
           if (side > 0) res.control = c;
         }
       }
-    } else if (const LidFap lf = lid_fap(model, *map, side, fdp->vertex); lf.muscle >= 0) {
-      // A lid closing: its tarsus turned about the eyeball's centre until
-      // the FDP (on the margin, held with the tarsus) has come down by the
-      // value; the lid above follows through the tissue. The FDP's drop
-      // grows with the turn until the FDP passes under the centre; the turn
-      // is found by bisection on the placement itself.
-      const int node = skin.node(kEpidermis, fdp->vertex);
-      const Eigen::Vector3d along = side * dir;
-      LidTurn lid;
-      lid.muscle = lf.muscle;
-      auto moved = [&](double angle) {
-        Eigen::MatrixXd X = skin.X0;
-        lid.angle = angle;
-        if (!place_turned_lid(model, lid, X, nullptr)) return 0.0;
-        return (X.row(node) - skin.X0.row(node)).dot(along.transpose());
-      };
-      // The first of 180 steps of the turn, up to where the lids meet, at
-      // which the FDP has come down by the value, refined by bisection;
-      // else the step that takes it furthest (`most`).
-      double most = 0;
-      const Muscle &driver = model.muscles[static_cast<size_t>(lf.muscle)];
-      const double last = driver.closing_turn > 0 ? driver.closing_turn : M_PI / lf.share;
-      auto find_turn = [&] {
-        double lo = 0, best = 0;
-        most = -std::numeric_limits<double>::infinity();
-        for (int step = 1; step <= 180; ++step) {
-          const double t = step * last / 180;
-          const double d = moved(t);
-          if (d >= value) {
-            double hi = t;
-            for (int halving = 0; halving < 60; ++halving) {
-              const double mid = 0.5 * (lo + hi);
-              (moved(mid) < value ? lo : hi) = mid;
-            }
-            most = value;
-            return 0.5 * (lo + hi);
-          }
-          if (d > most) most = d, best = t;
-          lo = t;
-        }
-        return best;
-      };
-      FactorCache cache;
-      Expected<Pose> pz = Status::error("no pose");
-      // On a simulation mesh, the input's skin over the eyeball is lifted by
-      // blending its coarse triangle's corners' displacements: its offset
-      // from the coarse triangle does not turn with the lid, and where the
-      // lid has turned far, the lifted skin sinks toward the ball. One more
-      // round holds the tarsus further off by what it sank.
-      for (int round = 0; round < 2; ++round) {
-        lid.angle = find_turn();
-        Activation a;
-        a.lids.push_back(lid);
-        pz = solve_pose(model, a, &cache);
-        if (!pz || !lifted_eye) break;
-        const double sunk = lifted_eye(pose_epidermis(model, *pz) - skin.X0.topRows(skin.n), lf.muscle);
-        if (!(sunk > 0)) break;
-        lid.clearance += sunk;
-      }
-      o.scale = lid.angle;
-      const int met = static_cast<int>(std::floor(most / unit));  // FAP units where the lids meet
-      if (!pz) {
-        o.message = pz.status().message();
-      } else if (most < value && o.in_between && driver.closing_turn > 0 && met >= 1) {
-        // The lids meet short of the in-between's value: the target is the
-        // shut lid, at the value that shuts it (formats/afm.md: any
-        // references will do), so that a stream reaching it shows the lid
-        // shut and not a chord of the arc past it.
-        pose = std::move(*pz);
-        ok = true;
-        shrink = met * unit / most;
-        o.reference = side * met;
-        o.prescribed = side * met * unit * dir;
-        o.message = "the lids meet at " + std::to_string(met) + " (" +
-                    std::to_string(static_cast<int>(std::lround(100.0 * met / reference))) + " % of " +
-                    std::to_string(reference) + "): made there";
-      } else {
-        pose = std::move(*pz);
-        ok = true;
-        if (most < value) {
-          o.reached = std::max(most, 0.0) / value;
-          o.message = "reaches " + std::to_string(static_cast<int>(std::lround(100 * o.reached))) +
-                      " % of the prescribed motion: " +
-                      (driver.closing_turn > 0 ? "there the lids meet" : "the margin's arc over the eyeball goes no further");
-        }
-      }
+    } else if (lid_cut) {
+      ok = turn_lid(lid);
     } else {
       std::vector<std::pair<int, double>> pattern;
       std::string missing;
@@ -956,6 +966,22 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       // pose's chord past 449 2.7 mm into the eyeball at 1024, against
       // 0.4 mm with the reference target alone extrapolated.
       ok = false;
+      // A closing lid's driver short of an in-between: the lid turned as a
+      // whole, where the skin stays a face (the 2k head's lower lids at 600;
+      // Song's upper lids fold where they meet, and keep none at 1024).
+      if (lid.muscle >= 0 && !lid_cut) {
+        const FapOutcome driven = o;
+        const double driven_shrink = shrink;
+        if (turn_lid(lid) && o.reached == 1 && !face_faults(pose_epidermis(model, pose)).any()) {
+          ok = true;
+          o.message += std::string(o.message.empty() ? "" : "; ") +
+                       "the lid turned as a whole (its driver's load reaches " +
+                       std::to_string(static_cast<int>(std::lround(100 * driven.reached))) + " %)";
+        } else {
+          o = driven;
+          shrink = driven_shrink;
+        }
+      }
     }
     if (ok) {
       Eigen::MatrixXd D = shrink * (pose_epidermis(model, pose) - skin.X0.topRows(skin.n));

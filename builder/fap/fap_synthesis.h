@@ -32,6 +32,8 @@
 // by bisection on the placement, up to the turn where the lids meet; an
 // in-between short of that is made at the value where they meet (its
 // reference), and dropped when that is not past the side's nearer target.
+// So does an in-between that a driver's load falls short of, kept where the
+// skin stays a face.
 // On a simulation mesh the tarsus is held further off the eyeball by what
 // the lifted skin over it sinks below its clearance, in one more solve.
 //
