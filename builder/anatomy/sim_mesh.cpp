@@ -174,9 +174,9 @@ class MirroredDecimater : public OpenMesh::Decimater::BaseDecimaterT<TriMesh> {
   using Base = OpenMesh::Decimater::BaseDecimaterT<TriMesh>;
   MirroredDecimater(TriMesh &mesh, std::vector<int> mirror) : Base(mesh), mesh_(mesh), mirror_(std::move(mirror)) {}
 
-  // Collapses until at most `target` vertices are left or no collapse is
-  // legal. Returns the collapses made; *unpaired gets those whose image
-  // could not follow.
+  // Collapses until at most `target` vertices are left (one fewer where the
+  // last collapse's image follows it) or no collapse is legal. Returns the
+  // collapses made; *unpaired gets those whose image could not follow.
   size_t decimate_to(size_t target, size_t *unpaired) {
     const size_t n = mesh_.n_vertices();
     best_.assign(n, TriMesh::HalfedgeHandle());
@@ -203,7 +203,7 @@ class MirroredDecimater : public OpenMesh::Decimater::BaseDecimaterT<TriMesh> {
       const int m1 = image.is_valid() ? mesh_.to_vertex_handle(image).idx() : -1;
       collapse(h, support);
       ++made, --alive;
-      if (m0 >= 0 && alive > target) {
+      if (m0 >= 0) {  // even past the target by one: the pair stays whole
         const TriMesh::HalfedgeHandle again =
             mesh_.find_halfedge(TriMesh::VertexHandle(m0), TriMesh::VertexHandle(m1));
         CollapseInfo ci(mesh_, again);

@@ -1541,7 +1541,8 @@ TEST(FapSynthesis, TargetsMadeOnACoarserSimulationMeshMatchTheSkins) {
   fo.calibrate_jaw = false;
   Expected<FaceModel> m = build_face_model(coarse, sim_fdps(b.head.fdps, *sim), fo);
   ASSERT_TRUE(m.is_ok()) << m.status().message();
-  EXPECT_EQ(m->tissue.n, kCoarse);
+  // (One fewer where a mirror pair of collapses ends the decimation.)
+  EXPECT_NEAR(m->tissue.n, kCoarse, 1);
   // The groups alone on both meshes (the coarse model calibrates no
   // helper).
   FapSynthesisOptions o;
@@ -1584,13 +1585,13 @@ TEST(FapSynthesis, TargetsMadeOnACoarserSimulationMeshMatchTheSkins) {
   // every skin vertex is bound, and its lifted delta is the builder's within
   // half a quantum (the controls' rounding) plus the Q15 weights' rounding
   // (at most 2^-15 of each corner's delta, 3 corners).
-  ASSERT_EQ(syn->lift.control_count, kCoarse);
+  ASSERT_EQ(syn->lift.control_count, m->tissue.n);
   const AfmContent content = fap_afm_content(b.head.scene, b.head.fdps, *m, *syn);
   const DocPtr hold = encoded_doc(content);
   const afm_doc *doc = hold.get();
   ASSERT_NE(doc, nullptr);
   ASSERT_NE(doc->lift, nullptr);
-  EXPECT_EQ(doc->lift->control_count, static_cast<uint32_t>(kCoarse));
+  EXPECT_EQ(doc->lift->control_count, static_cast<uint32_t>(m->tissue.n));
   const afm_part &skin_part = doc->geometry.parts[skin];
   ASSERT_EQ(doc->lift->runs[0].start, skin_part.first_vertex);
   ASSERT_GE(doc->lift->runs[0].length, skin_part.vertex_count);
