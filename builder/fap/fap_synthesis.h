@@ -69,9 +69,9 @@
 // s = 1: the table's contractions at 100 %). A group that falls short there
 // gets one more solve, from that pose, that may pass the range with its
 // tensions extrapolated up to kMaxFapScale, within a budget of Newton
-// iterations (none where the skin already folds at s = 1, or where the FDP
+// iterations (none where the skin already folds at s = 1, where the FDP
 // moves the wrong way at s = 1: the load control steers an action that grows
-// with the load); its pose is kept
+// with the load, or where it moves less than a FAP unit); its pose is kept
 // if the skin stays a face (face_model.h, skin_faults: no skin triangle
 // turned over, nothing below the skull; on a simulation mesh, none of the
 // lifted skin's either: FapSynthesisOptions::sim); where it does not, a pose short of

@@ -128,8 +128,8 @@ const Built &head_1k() {
     // as a whole), the lower one to all of it.
     fo.calibrate_only = {"zygomaticus_major_left", "depressor_anguli_left", "frontalis_major_left", "corrugator_left",
                          "mentalis_left", "mentalis_right", "zygomaticus_minor_left", "upper_lip_left",
-                         "risorius_left", "orbicularis_oris", "nasalis_left", "palpebral_upper_left",
-                         "palpebral_lower_left"};
+                         "risorius_left", "orbicularis_oris", "nasalis_left", "nasalis_right",
+                         "palpebral_upper_left", "palpebral_lower_left"};
     b = afmtest::build_reference_model(1000, fo);
   }
   return *b;
@@ -880,6 +880,30 @@ TEST(FapSynthesis, AnInBetweenTheLidDriverFallsShortOfIsMadeByTurningTheLid) {
                                        by[600].second->displacement[static_cast<size_t>(m.skin)]);
   EXPECT_EQ(turned_over(R, s.F, R + blend), 0) << "450, blended";
   EXPECT_LE(deepest_in_eyeballs(s, R + blend), m.quantum) << "450, blended";
+}
+
+// A group that moves its FDP less than a FAP unit at its calibrated range
+// makes no target, and nothing is tried past the range: FAP 64 (bend the
+// nose) on the 1k head with the FAP unit (ENS0) taken 40 times longer, so
+// that the nasalis pair moves 2.1 at its range a fraction of a unit.
+// Before, the group went on in a solve up to 4 times the table's
+// contractions, which made no target either (Song's FAP 64: two failed
+// solves, 0.7 s of CPU).
+TEST(FapSynthesis, AGroupThatMovesItsFdpLessThanAUnitAtItsRangeIsNotExtrapolated) {
+  const Built &b = head_1k();
+  FaceModel m = b.model;
+  m.fapu.ens0 *= 40;
+  FapSynthesisOptions o;
+  o.only = {64};
+  o.negative_sides = false;
+  o.steer = false;
+  Expected<FapSynthesis> syn = synthesize_faps(b.head.scene, m, o);
+  ASSERT_TRUE(syn.is_ok()) << syn.status().message();
+  ASSERT_EQ(syn->outcomes.size(), 1u);
+  const FapOutcome &out = syn->outcomes[0];
+  EXPECT_FALSE(out.made);
+  EXPECT_NE(out.message.find("less than a FAP unit"), std::string::npos) << out.message;
+  EXPECT_NE(out.message.find("beyond them nothing is tried"), std::string::npos) << out.message;
 }
 
 // The check that stops a group's extrapolation (face_model.h) sees a fold
