@@ -58,10 +58,12 @@ std::vector<FapMapping> make_table() {
   add(18, D::Muscles, 300, {{"mentalis_left", 100}, {"mentalis_right", 100}},
       {{"mentalis_left", -100}, {"mentalis_right", -100}}, "mentalis lifts the chin's skin");
   // ---- group 3: eyelids, eyeballs, pupils ----
-  const char *upper = "the upper lid's driver turns it down over the eyeball (without an eye part: the upper "
-                      "lid's half of orbicularis oculi's pose)";
-  const char *lower = "the lower lid's driver turns it up over the eyeball (without an eye part: the lower "
-                      "lid's half of orbicularis oculi's pose)";
+  const char *upper = "the upper lid's driver turns it down over the eyeball; where its load falls short, the "
+                      "lid turned as a whole by its tarsus (without an eye part: the upper lid's half of "
+                      "orbicularis oculi's pose)";
+  const char *lower = "the lower lid's driver turns it up over the eyeball; where its load falls short, the "
+                      "lid turned as a whole by its tarsus (without an eye part: the lower lid's half of "
+                      "orbicularis oculi's pose)";
   add(19, D::Muscles, 300, {{"palpebral_upper_left", 100}}, {{"palpebral_upper_left", -100}}, upper);
   add(20, D::Muscles, 300, {{"palpebral_upper_right", 100}}, {{"palpebral_upper_right", -100}}, upper);
   add(21, D::Muscles, 300, {{"palpebral_lower_left", 100}}, {{"palpebral_lower_left", -100}}, lower);
