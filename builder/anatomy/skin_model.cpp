@@ -302,16 +302,20 @@ Expected<SkinModel> build_skin_model(const Scene &scene, int part, const TissueP
   return m;
 }
 
+double rest_eye_clearance(double rest, double longest_sq, double radius) {
+  // The skin between held nodes dips toward the ball (kChordDip).
+  return std::clamp(rest, 0.0, std::max(kEyeClearance * radius, kChordDip * longest_sq / radius));
+}
+
 void hold_off_eyeball(SkinModel &m, int v, int eye) {
   const EyeSphere &ball = m.eyes[static_cast<size_t>(eye)];
   const Eigen::RowVector3d p = m.X0.row(m.node(kEpidermis, v));
-  const double rest = (p.transpose() - ball.centre).norm() - ball.radius;
-  // The skin between held nodes dips toward the ball (kChordDip).
-  double dip = 0;
+  double longest_sq = 0;
   for (int u : m.neighbours[static_cast<size_t>(v)])
-    dip = std::max(dip, kChordDip * (p - m.X0.row(m.node(kEpidermis, u))).squaredNorm() / ball.radius);
+    longest_sq = std::max(longest_sq, (p - m.X0.row(m.node(kEpidermis, u))).squaredNorm());
   m.eye_near[static_cast<size_t>(v)] = static_cast<int8_t>(eye);
-  m.eye_clearance[static_cast<size_t>(v)] = std::clamp(rest, 0.0, std::max(kEyeClearance * ball.radius, dip));
+  m.eye_clearance[static_cast<size_t>(v)] =
+      rest_eye_clearance((p.transpose() - ball.centre).norm() - ball.radius, longest_sq, ball.radius);
 }
 
 int nearest_node(const SkinModel &m, int layer, const Eigen::Vector3d &p) {

@@ -167,10 +167,15 @@ struct SkinModel {
   double stiffness(const Spring &s) const;
 };
 
+// How far off an eyeball of radius `radius` skin is held at rest whose
+// distance from the sphere is `rest` and whose longest edge's square is
+// `longest_sq` (model units): `rest`, up to kEyeClearance radii or the
+// edge's chord dip (kChordDip), whichever is more; never below 0.
+double rest_eye_clearance(double rest, double longest_sq, double radius);
+
 // Makes the solver hold vertex v's epidermal node off eyeball `eye`
-// (SkinModel::eye_near, with its eye_clearance: the rest distance up to
-// kEyeClearance radii or the longest edge's chord dip). X0 and neighbours
-// must be set.
+// (SkinModel::eye_near, with its eye_clearance: rest_eye_clearance). X0 and
+// neighbours must be set.
 void hold_off_eyeball(SkinModel &m, int v, int eye);
 
 // How far off its eyeball's sphere the solver holds vertex v's epidermal

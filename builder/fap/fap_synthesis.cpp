@@ -284,10 +284,9 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
 
   // How far the input's skin, lifted from a coarse displacement Dc (#Vc x
   // 3), sinks below the clearance the solver would hold it at off the
-  // eyeball of lid driver `muscle` (skin_model.h, eye_clearance: its rest
-  // distance, up to the larger of kEyeClearance radii and its longest edge's
-  // chord dip), among its vertices bound to that lid's tarsus; model units,
-  // 0 when none does. Empty without a simulation mesh.
+  // eyeball of lid driver `muscle` (skin_model.h, rest_eye_clearance), among
+  // its vertices bound to that lid's tarsus; model units, 0 when none does.
+  // Empty without a simulation mesh.
   std::function<double(const Eigen::MatrixXd &, int)> lifted_eye;
   if (sim) {
     std::vector<uint8_t> used(static_cast<size_t>(sim->skin_V.rows()), 0);
@@ -316,8 +315,8 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
           bound = bound || (sim->binding.weight(v, j) > 0 && tarsus[static_cast<size_t>(sim->binding.corner(v, j))]);
         if (!bound) continue;
         const double rest = (sim->skin_V.row(v).transpose() - ball.centre).norm() - ball.radius;
-        const double dip = kChordDip * longest[static_cast<size_t>(v)] * longest[static_cast<size_t>(v)] / ball.radius;
-        const double held = std::clamp(rest, 0.0, std::max(kEyeClearance * ball.radius, dip));
+        const double longest_v = longest[static_cast<size_t>(v)];
+        const double held = rest_eye_clearance(rest, longest_v * longest_v, ball.radius);
         worst = std::max(worst, ball.radius + held - (E.row(v).transpose() - ball.centre).norm());
       }
       return worst;
