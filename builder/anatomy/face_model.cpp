@@ -268,6 +268,10 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
     if (m.name.rfind("mentalis", 0) == 0) remove_from_influence(m, lips->upper);
     if (m.name.rfind("upper_lip", 0) == 0) remove_from_influence(m, lips->lower);
   }
+  // The lips' contact pairs, from the same searches.
+  if (model.tissue.params.lip_contact_modulus > 0)
+    model.tissue.lip_pairs = lip_pairs(model.tissue, lips->upper, lips->lower, model.tissue.params.lip_contact_modulus,
+                                       kLipBand * model.fapu.mns0, kLipMargin * model.fapu.mns0);
   for (const Muscle &m : model.muscles)
     if (table[static_cast<size_t>(m.def)].skull_free)
       for (int v : m.influence) model.tissue.skull_free[static_cast<size_t>(v)] = 1;

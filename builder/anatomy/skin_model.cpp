@@ -158,6 +158,7 @@ Expected<SkinModel> build_skin_model(const Scene &scene, int part, const TissueP
                          "hypodermis_depth < 1");
   if (!(params.collapse_modulus >= 0) || !(params.collapse_knee > 0 && params.collapse_knee <= 1))
     return Status::error("skin model: need collapse_modulus >= 0 and 0 < collapse_knee <= 1");
+  if (!(params.lip_contact_modulus >= 0)) return Status::error("skin model: need lip_contact_modulus >= 0");
 
   SkinModel m;
   m.part = part;

@@ -35,6 +35,7 @@
 #include <utility>
 #include <vector>
 
+#include "anatomy/lip_contact.h"
 #include "core/scene.h"
 #include "core/status.h"
 
@@ -72,6 +73,9 @@ struct TissueParams {
   // on the generated heads and Song; docs/anatomy.md gives the cost).
   double collapse_modulus = 0.0;
   double collapse_knee = 0.5;
+  // Lip-lip contact (lip_contact.h): the contact pressure at a crossing of
+  // one margin, relative like the slabs' moduli; 0: off.
+  double lip_contact_modulus = 1.0;
   double density = 1.0;        // mass per volume, for the lumped masses
 };
 
@@ -159,6 +163,9 @@ struct SkinModel {
   // vertices cross: Song's eyeball showed through the lid as dark specks.
   // In a pose it grows as the edges stretch (eye_clearance_in).
   std::vector<double> eye_clearance;
+  // The lips' contact pairs (lip_contact.h), made by build_face_model from
+  // the mouth-window searches; empty: no contact.
+  std::vector<LipPair> lip_pairs;
 
   int node(int layer, int vertex) const { return layer * n + vertex; }
   int layer_of(int node) const { return node / n; }

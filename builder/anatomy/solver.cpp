@@ -58,22 +58,34 @@ FloorValue slab_floor(const SkinModel &m, const Eigen::MatrixXd &X, const Elemen
 }
 
 // The unknowns of one dynamic set and the fixed sparsity of their Hessian:
-// 3x3 blocks between nodes joined by a spring or sharing an element. Built
-// once per set; every linearisation writes values into the same pattern.
+// 3x3 blocks between nodes joined by a spring or a lip pair (ties) or sharing
+// an element. Built once per set; every linearisation writes values into the
+// same pattern.
 struct System {
   const SkinModel &m;
   std::vector<int> nodes;  // free nodes, global
   std::vector<int> local;  // global node -> local index, or -1
   std::vector<int> springs;
+  std::vector<int> lips;  // SkinModel::lip_pairs with a free node
   std::vector<Element> elements;
   std::vector<uint8_t> rejects;  // per local node: held above its skull plane
   std::vector<int8_t> eye;       // per local node: the eyeball (SkinModel::eyes) it is held off, or -1
   std::vector<std::vector<int>> adj;  // per local node: sorted block neighbours (itself included)
-  std::vector<std::array<Block, 4>> spring_blocks;  // aa, bb, ab, ba
+  std::vector<std::array<Block, 4>> tie_blocks;     // per spring, then per lip pair: aa, bb, ab, ba
   std::vector<Block> element_blocks;                // 81 per element, (i, j) at 9 i + j
   std::vector<Block> diagonal;                      // per local node
   SpMat pattern;                                    // dofs x dofs, values unset
   int dofs() const { return 3 * static_cast<int>(nodes.size()); }
+  size_t ties() const { return springs.size() + lips.size(); }
+  // The two nodes of tie q: spring q, or lip pair q - springs.size().
+  std::pair<int, int> tie(size_t q) const {
+    if (q < springs.size()) {
+      const Spring &s = m.springs[static_cast<size_t>(springs[q])];
+      return {s.a, s.b};
+    }
+    const LipPair &p = m.lip_pairs[static_cast<size_t>(lips[q - springs.size()])];
+    return {p.upper, p.lower};
+  }
 
   Block block(int i, int j) const {
     const std::vector<int> &col = adj[static_cast<size_t>(j)];
@@ -106,6 +118,11 @@ struct System {
           if (m.stiffness(m.springs[static_cast<size_t>(s)]) > 0) springs.push_back(s);
         }
     std::sort(springs.begin(), springs.end());
+    for (size_t p = 0; p < m.lip_pairs.size(); ++p) {
+      const LipPair &lp = m.lip_pairs[p];
+      if (local[static_cast<size_t>(lp.upper)] >= 0 || local[static_cast<size_t>(lp.lower)] >= 0)
+        lips.push_back(static_cast<int>(p));
+    }
     double mean = 0;
     for (int f = 0; f < m.F.rows(); ++f) mean += std::abs(m.rest_volume[f]);
     mean /= std::max<Eigen::Index>(1, m.F.rows());
@@ -149,28 +166,28 @@ struct System {
 
   void build_pattern() {
     const int nn = static_cast<int>(nodes.size());
-    // Each node's neighbours: the free nodes of its elements and springs,
+    // Each node's neighbours: the free nodes of its elements and ties,
     // gathered once each (a node sits in a dozen elements of 9 nodes: sorting
     // every repeat cost Song's AFM a tenth of its time).
     std::vector<int> start(static_cast<size_t>(nn) + 1, 0), incident;
     for (const Element &e : elements)
       for (int i : e.local)
         if (i >= 0) ++start[static_cast<size_t>(i) + 1];
-    for (int si : springs) {
-      const Spring &s = m.springs[static_cast<size_t>(si)];
-      for (int g : {s.a, s.b})
+    for (size_t q = 0; q < ties(); ++q) {
+      const auto [a, b] = tie(q);
+      for (int g : {a, b})
         if (const int i = local[static_cast<size_t>(g)]; i >= 0) ++start[static_cast<size_t>(i) + 1];
     }
     for (int i = 0; i < nn; ++i) start[static_cast<size_t>(i) + 1] += start[static_cast<size_t>(i)];
-    // incident[start[i] ..]: element e as e, spring q as -1 - q.
+    // incident[start[i] ..]: element e as e, tie q as -1 - q.
     incident.resize(static_cast<size_t>(start.back()));
     std::vector<int> fill(start.begin(), start.end() - 1);
     for (size_t e = 0; e < elements.size(); ++e)
       for (int i : elements[e].local)
         if (i >= 0) incident[static_cast<size_t>(fill[static_cast<size_t>(i)]++)] = static_cast<int>(e);
-    for (size_t q = 0; q < springs.size(); ++q) {
-      const Spring &s = m.springs[static_cast<size_t>(springs[q])];
-      for (int g : {s.a, s.b})
+    for (size_t q = 0; q < ties(); ++q) {
+      const auto [a, b] = tie(q);
+      for (int g : {a, b})
         if (const int i = local[static_cast<size_t>(g)]; i >= 0)
           incident[static_cast<size_t>(fill[static_cast<size_t>(i)]++)] = -1 - static_cast<int>(q);
     }
@@ -188,8 +205,8 @@ struct System {
         if (x >= 0) {
           for (int j : elements[static_cast<size_t>(x)].local) add(j);
         } else {
-          const Spring &s = m.springs[static_cast<size_t>(springs[static_cast<size_t>(-1 - x)])];
-          add(local[static_cast<size_t>(s.a)]), add(local[static_cast<size_t>(s.b)]);
+          const auto [ga, gb] = tie(static_cast<size_t>(-1 - x));
+          add(local[static_cast<size_t>(ga)]), add(local[static_cast<size_t>(gb)]);
         }
       }
       std::sort(a.begin(), a.end());
@@ -210,9 +227,9 @@ struct System {
     std::fill(pattern.valuePtr(), pattern.valuePtr() + nnz, 0.0);
     diagonal.resize(static_cast<size_t>(nn));
     for (int i = 0; i < nn; ++i) diagonal[static_cast<size_t>(i)] = block(i, i);
-    // The blocks each spring and element adds to, column by column: with
+    // The blocks each tie and element adds to, column by column: with
     // the column's row positions at hand (`row_at`), no search.
-    spring_blocks.assign(springs.size(), {});
+    tie_blocks.assign(ties(), {});
     element_blocks.assign(81 * elements.size(), Block{});
     std::vector<int> row_at(static_cast<size_t>(nn), -1);
     for (int j = 0; j < nn; ++j) {
@@ -232,9 +249,9 @@ struct System {
           }
         } else {
           const size_t q = static_cast<size_t>(-1 - x);
-          const Spring &s = m.springs[static_cast<size_t>(springs[q])];
-          const int a = local[static_cast<size_t>(s.a)], b = local[static_cast<size_t>(s.b)];
-          std::array<Block, 4> &bl = spring_blocks[q];
+          const auto [ga, gb] = tie(q);
+          const int a = local[static_cast<size_t>(ga)], b = local[static_cast<size_t>(gb)];
+          std::array<Block, 4> &bl = tie_blocks[q];
           if (j == a) {
             bl[0] = at(a);
             if (b >= 0) bl[3] = at(b);  // (b, a)
@@ -295,7 +312,7 @@ void add_block(double *values, Block b, const M &B) {
 // d2V/dp2, leaving its Gauss-Newton part), which keeps K positive
 // semi-definite everywhere; `full`, Newton converges quadratically near an
 // equilibrium, where K is definite anyway.
-void linearise(const System &sys, const Eigen::MatrixXd &X, SpMat &K, Vec &diag, bool full = false) {
+void linearise(const System &sys, bool contact, const Eigen::MatrixXd &X, SpMat &K, Vec &diag, bool full = false) {
   const SkinModel &m = sys.m;
   if (K.nonZeros() != sys.pattern.nonZeros()) K = sys.pattern;
   double *val = K.valuePtr();
@@ -309,7 +326,19 @@ void linearise(const System &sys, const Eigen::MatrixXd &X, SpMat &K, Vec &diag,
     tension(s, m.stiffness(s), l, &t, &dt);
     const double geo = (t >= 0 || full ? t : 0.0) / l;
     const Eigen::Matrix3d B = (dt - geo) * u * u.transpose() + geo * Eigen::Matrix3d::Identity();
-    const std::array<Block, 4> &bl = sys.spring_blocks[q];
+    const std::array<Block, 4> &bl = sys.tie_blocks[q];
+    if (bl[0].base >= 0) add_block(val, bl[0], B);
+    if (bl[1].base >= 0) add_block(val, bl[1], B);
+    if (bl[2].base >= 0) add_block(val, bl[2], -B), add_block(val, bl[3], -B);
+  }
+  // Lip pairs: d2E/ds2 up up^T, up = +y (lip_contact.h).
+  for (size_t i = 0; contact && i < sys.lips.size(); ++i) {
+    const LipPair &p = m.lip_pairs[static_cast<size_t>(sys.lips[i])];
+    const double c = lip_contact_energy(p, X(p.upper, 1) - X(p.lower, 1)).d2;
+    if (c <= 0) continue;
+    Eigen::Matrix3d B = Eigen::Matrix3d::Zero();
+    B(1, 1) = c;
+    const std::array<Block, 4> &bl = sys.tie_blocks[sys.springs.size() + i];
     if (bl[0].base >= 0) add_block(val, bl[0], B);
     if (bl[1].base >= 0) add_block(val, bl[1], B);
     if (bl[2].base >= 0) add_block(val, bl[2], -B), add_block(val, bl[3], -B);
@@ -386,7 +415,7 @@ void scatter_rows(const System &sys, const Vec &x, Eigen::MatrixXd &P) {
 }
 
 // Internal plus external force on the free nodes.
-void net_force(const System &sys, const ForceField &forces, const Eigen::MatrixXd &ref,
+void net_force(const System &sys, bool contact, const ForceField &forces, const Eigen::MatrixXd &ref,
                const Eigen::MatrixXd &X, Vec &r) {
   const SkinModel &m = sys.m;
   r.setZero(sys.dofs());
@@ -400,6 +429,14 @@ void net_force(const System &sys, const ForceField &forces, const Eigen::MatrixX
     const int la = sys.local[static_cast<size_t>(s.a)], lb = sys.local[static_cast<size_t>(s.b)];
     if (la >= 0) r.segment<3>(3 * la) += f;
     if (lb >= 0) r.segment<3>(3 * lb) -= f;
+  }
+  for (size_t i = 0; contact && i < sys.lips.size(); ++i) {
+    const LipPair &p = m.lip_pairs[static_cast<size_t>(sys.lips[i])];
+    const double f = -lip_contact_energy(p, X(p.upper, 1) - X(p.lower, 1)).d1;  // pushes the upper vertex up
+    if (f == 0) continue;
+    const int la = sys.local[static_cast<size_t>(p.upper)], lb = sys.local[static_cast<size_t>(p.lower)];
+    if (la >= 0) r[3 * la + 1] += f;
+    if (lb >= 0) r[3 * lb + 1] -= f;
   }
   Eigen::Matrix<double, 9, 3> g;
   for (const Element &el : sys.elements) {
@@ -436,13 +473,17 @@ void net_force(const System &sys, const ForceField &forces, const Eigen::MatrixX
 }
 
 // Total potential energy of the system: springs, volume, external load.
-double total_energy(const System &sys, const ForceField &forces, const Eigen::MatrixXd &ref,
+double total_energy(const System &sys, bool contact, const ForceField &forces, const Eigen::MatrixXd &ref,
                     const Eigen::MatrixXd &X) {
   const SkinModel &m = sys.m;
   double e = 0;
   for (int si : sys.springs) {
     const Spring &s = m.springs[static_cast<size_t>(si)];
     e += spring_energy(s, m.stiffness(s), (X.row(s.b) - X.row(s.a)).norm());
+  }
+  for (size_t i = 0; contact && i < sys.lips.size(); ++i) {
+    const LipPair &p = m.lip_pairs[static_cast<size_t>(sys.lips[i])];
+    e += lip_contact_energy(p, X(p.upper, 1) - X(p.lower, 1)).e;
   }
   for (const Element &el : sys.elements) {
     if (el.weight > 0) {
@@ -711,7 +752,7 @@ const Ldlt *rest_factor(FactorCache::Entry &e) {
     e.rest = std::make_unique<Ldlt>(e.symbolic);
     SpMat K;
     Vec diag;
-    linearise(*e.sys, e.sys->m.X0, K, diag);
+    linearise(*e.sys, false, e.sys->m.X0, K, diag);  // no contact at rest
     e.rest_ok = e.analysed && e.rest->factorize(K) != Ldlt::Result::kSingular;
   }
   return e.rest_ok ? e.rest.get() : nullptr;
@@ -721,10 +762,10 @@ const Ldlt *rest_factor(FactorCache::Entry &e) {
 
 Eigen::MatrixXd residual_forces(const SkinModel &model, const std::vector<int> &vertices,
                                 const ForceField &forces, const Eigen::MatrixXd &reference,
-                                const Eigen::MatrixXd &X) {
+                                const Eigen::MatrixXd &X, bool contact) {
   System sys(model, vertices);
   Vec r;
-  net_force(sys, forces, reference, X, r);
+  net_force(sys, contact, forces, reference, X, r);
   Eigen::MatrixXd out = Eigen::MatrixXd::Zero(X.rows(), 3);
   scatter_rows(sys, r, out);
   return out;
@@ -759,6 +800,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     return st;
   };
   const std::string name = solver_name(options.kind);
+  const bool contact = options.lip_contact;
   if (!(options.tolerance > 0)) return done(false, "solver: tolerance must be positive");
   if (control && options.kind == SolverKind::ImplicitEuler)
     return done(false, "solver: implicit-euler cannot solve for a tension (use a newton solver)");
@@ -786,15 +828,15 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     const int max_steps = options.max_iterations > 0 ? options.max_iterations : 2000;
     Vec mass(n);
     for (size_t i = 0; i < sys.nodes.size(); ++i) mass.segment<3>(3 * static_cast<int>(i)).setConstant(model.mass[sys.nodes[i]]);
-    linearise(sys, X, K, diag);
+    linearise(sys, contact, X, K, diag);
     const double t0 = std::sqrt(mass.mean() / std::max(diag.mean(), 1e-300));
     const double h = options.time_step * t0, gamma = options.damping / t0;
     add_load_stiffness(sys, forces, X, K, diag);
     Vec v = Vec::Zero(n), dv, Kv(n), b(n);
     for (int step = 0; step < max_steps; ++step) {
-      net_force(sys, forces, reference, X, r);
+      net_force(sys, contact, forces, reference, X, r);
       if (step > 0) {
-        linearise(sys, X, K, diag);
+        linearise(sys, contact, X, K, diag);
         add_load_stiffness(sys, forces, X, K, diag);
       }
       st.residual = displacement_estimate([&] { Vec f = r; contacts.filter(f); return f; }(), diag);
@@ -890,9 +932,9 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
   double known_energy = 0;
   for (int it = 0;; ++it) {
     const ForceField load = load_at(t);
-    net_force(sys, load, reference, X, r);
+    net_force(sys, contact, load, reference, X, r);
     if (!finite(r)) return done(false, name + ": non-finite force");
-    linearise(sys, X, K, diag, true);
+    linearise(sys, contact, X, K, diag, true);
     add_load_stiffness(sys, load, X, K, diag);
     Vec rf = r;
     contacts.filter(rf);
@@ -942,7 +984,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     // 1,424 -> 1,362; the same models and reports.
     bool full = true;
     auto project = [&] {
-      linearise(sys, X, K, diag, full = false);
+      linearise(sys, contact, X, K, diag, full = false);
       add_load_stiffness(sys, load, X, K, diag);
     };
     auto shifted = [&] {
@@ -1061,14 +1103,14 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     Vec rn = rf;
     if (control) rn += dt * [&] { Vec gf = g; contacts.filter(gf); return gf; }();
     x0 = gather_rows(sys, X);
-    const double e0 = energy_known ? known_energy : total_energy(sys, next_load, reference, X);
+    const double e0 = energy_known ? known_energy : total_energy(sys, contact, next_load, reference, X);
     const double slope = rn.dot(dx);
     double alpha = 1, e_trial = 0;
     Eigen::MatrixXd Xt = X;
     for (int ls = 0; ls < 12; ++ls) {
       trial = x0 + alpha * dx;
       scatter_rows(sys, trial, Xt);
-      e_trial = total_energy(sys, next_load, reference, Xt);
+      e_trial = total_energy(sys, contact, next_load, reference, Xt);
       if ((std::isfinite(e_trial) && e_trial <= e0 - 1e-4 * alpha * std::max(slope, 0.0)) || ls == 11) break;
       alpha *= 0.5;
     }
@@ -1082,7 +1124,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
       for (double longer : {2.0, 4.0, 8.0}) {
         const Vec further = x0 + longer * dx;
         scatter_rows(sys, further, Xt);
-        const double e = total_energy(sys, next_load, reference, Xt);
+        const double e = total_energy(sys, contact, next_load, reference, Xt);
         if (!(std::isfinite(e) && e < e_taken)) break;
         e_taken = e, trial = further, alpha = longer;
       }

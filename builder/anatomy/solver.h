@@ -50,7 +50,12 @@
 //             inside, then held with the sphere's tangent plane at the node,
 //             renewed at every update, as its plane. A
 //             node that also has a skull plane keeps it until it meets the
-//             sphere.
+//             sphere;
+//   lips      with SolverOptions::lip_contact, each lip pair's energy
+//             (lip_contact.h): a cubic penalty on the upper lip's vertex
+//             sinking below its partner on the lower lip, coupling the two
+//             nodes (its Hessian is positive semi-definite: in both
+//             tangents).
 //
 // Solvers (bench_builder compares them; docs/anatomy.md has the figures):
 //   newton          Newton's method on the static equations. The step solves
@@ -148,6 +153,13 @@ struct SolverOptions {
   // that the line search accepts is tried again at 2, 4 and 8 times its
   // length while the total energy keeps falling (see "newton" above).
   bool extend_steps = true;
+  // Hold the lips apart (SkinModel::lip_pairs, lip_contact.h; "lips" above).
+  // Off for the FAP targets and the muscles' calibration: MPEG-4 moves each
+  // lip by its own FAPs, and a FAP that presses one lip onto the other moves
+  // it past the other's rest place (the player's sum of both lips' targets is
+  // the pressed lips). On for poses of several groups at once: visemes and
+  // expressions.
+  bool lip_contact = false;
 };
 
 struct SolveStats {
@@ -231,10 +243,11 @@ Expected<Eigen::MatrixXd> linear_response(const SkinModel &model, const std::vec
                                           const ForceField &load, FactorCache *cache);
 
 // The residual force (4n x 3, zero on fixed nodes) of positions X: springs,
-// volume and `forces`, for checks and tests.
+// volume, the lips' contact when `lip_contact` (SolverOptions::lip_contact)
+// and `forces`, for checks and tests.
 Eigen::MatrixXd residual_forces(const SkinModel &model, const std::vector<int> &vertices,
                                 const ForceField &forces, const Eigen::MatrixXd &reference,
-                                const Eigen::MatrixXd &X);
+                                const Eigen::MatrixXd &X, bool lip_contact = false);
 
 // Whether the skull rejects vertex v's nodes (see the header comment).
 bool skull_rejects(const SkinModel &model, int v);

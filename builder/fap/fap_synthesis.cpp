@@ -426,6 +426,10 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       o.message = "nothing to pose: " + o.message;
     } else {
       FactorCache cache;
+      // Muscles of both lips act together here: the lips meet, not pass
+      // into each other (SolverOptions::lip_contact).
+      SolverOptions together = model.solver;
+      together.lip_contact = true;
       // `reduced` marks the muscles (one per a.muscles entry, then the jaw)
       // that `share` scales; the others keep the table's contraction.
       // Each solve starts from `from` (a pose of a smaller share of the same
@@ -439,6 +443,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         const Pose guess = from ? Pose() : superposed_pose(model, b);
         PoseOptions po;
         po.start = from ? from : &guess;
+        po.solver = &together;
         return solve_pose(model, b, &cache, po);
       };
       // The table's pose. Where it tears the skin (joy turned the crease at

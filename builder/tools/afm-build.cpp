@@ -363,6 +363,9 @@ int main(int argc, char **argv) {
     std::printf("  eyeball '%s': radius %.4g, %d skin vertices slide on it (the lids)\n",
                 scene.parts[static_cast<size_t>(t.eyes[e].part)].name.c_str(), t.eyes[e].radius, over);
   }
+  if (!t.lip_pairs.empty())
+    std::printf("  lips: %zu vertex pairs kept from passing into each other in visemes and expressions\n",
+                t.lip_pairs.size());
   std::printf("solver: %s, tolerance %.3g (half the AFM quantum %.3g), wave threshold %.3g\n",
               solver_name(model->solver.kind), model->solver.tolerance, model->quantum, model->wave_threshold);
   for (const std::string &n : model->notes) std::printf("note: %s\n", n.c_str());

@@ -793,6 +793,116 @@ TEST(Physics, TheLidDriversCloseSongsLidsOverTheEyeball) {
   EXPECT_FALSE(skin_faults(m, up.topRows(m.tissue.n)).tears());
 }
 
+// Lip-lip contact (anatomy/lip_contact.h). The pair energy: zero above s_on,
+// C2 there, and its derivatives those of its value (central differences).
+TEST(LipContact, ThePairEnergyIsSmoothAndItsDerivativesMatch) {
+  LipPair p;
+  p.on = 0.3;
+  p.margin = 0.05;
+  p.stiffness = 2.0;
+  for (double s : {0.3, 0.31, 1.0}) {
+    const LipContactValue v = lip_contact_energy(p, s);
+    EXPECT_EQ(v.e, 0.0);
+    EXPECT_EQ(v.d1, 0.0);
+    EXPECT_EQ(v.d2, 0.0);
+  }
+  const double h = 1e-6;
+  for (double s : {0.299, 0.28, 0.25, 0.2, 0.1, -0.2}) {
+    const LipContactValue v = lip_contact_energy(p, s);
+    const LipContactValue up = lip_contact_energy(p, s + h), down = lip_contact_energy(p, s - h);
+    EXPECT_GT(v.e, 0.0);
+    EXPECT_LT(v.d1, 0.0) << "pushes the upper vertex up";
+    EXPECT_GT(v.d2, 0.0);
+    EXPECT_NEAR((up.e - down.e) / (2 * h), v.d1, 1e-6 * (1 + std::abs(v.d1))) << s;
+    EXPECT_NEAR((up.d1 - down.d1) / (2 * h), v.d2, 1e-5 * (1 + std::abs(v.d2))) << s;
+  }
+  // A crossing of one margin: the contact pressure's force k.
+  EXPECT_NEAR(lip_contact_energy(p, p.on - p.margin).d1, -p.stiffness, 1e-12);
+  // C2 at s_on: the value and both derivatives vanish as s rises to it.
+  const LipContactValue near = lip_contact_energy(p, p.on - 1e-9);
+  EXPECT_LT(near.e, 1e-20);
+  EXPECT_LT(std::abs(near.d1), 1e-12);
+  EXPECT_LT(near.d2, 1e-5);
+}
+
+// The generated head's lips were cut apart along the seam (refhead): its
+// pairs are the seam's coincident vertices, one on each lip, and no others.
+TEST(LipContact, OnTheReferenceHeadThePairsAreTheLipSeam) {
+  const FaceModel &m = head_1k().model;
+  const SkinModel &s = m.tissue;
+  Expected<MouthLips> lips = mouth_lips(s, m.fdps);
+  ASSERT_TRUE(lips) << lips.status().message();
+  std::vector<std::pair<int, int>> seam;
+  for (int a : lips->upper)
+    for (int b : lips->lower)
+      if ((s.X0.row(a) - s.X0.row(b)).norm() < 1e-9) seam.emplace_back(a, b);
+  ASSERT_GE(seam.size(), 5u) << "the lips meet along a seam of coincident vertices";
+  std::vector<std::pair<int, int>> pairs;
+  for (const LipPair &p : s.lip_pairs) {
+    pairs.emplace_back(s.vertex_of(p.upper), s.vertex_of(p.lower));
+    EXPECT_EQ(s.layer_of(p.upper), kEpidermis);
+    EXPECT_EQ(p.on, 0.0) << "lips that touch at rest are in contact at once";
+    EXPECT_NEAR(p.margin, kLipMargin * m.fapu.mns0, 1e-15);
+    EXPECT_GT(p.stiffness, 0.0);
+  }
+  std::sort(seam.begin(), seam.end());
+  EXPECT_EQ(pairs, seam);
+  // Nothing of it at rest.
+  EXPECT_EQ(crossed_lip_pairs(s, s.X0, 0.0), 0);
+}
+
+// Both mentalis muscles push the lower lip up into the upper one. Without
+// contact it passes into it by more than a margin; with it the lips meet:
+// none crosses by more than one margin, the upper lip is pushed up, and the
+// solve converges with no NaN and no inverted element.
+TEST(Physics, PressedLipsMeetAndDoNotPassIntoEachOther) {
+  const FaceModel &m = head_1k().model;
+  const SkinModel &s = m.tissue;
+  const Muscle &left = m.muscles[static_cast<size_t>(m.find("mentalis_left"))];
+  const Muscle &right = m.muscles[static_cast<size_t>(m.find("mentalis_right"))];
+  const double t = 0.1;
+  ForceField f = [&](const Eigen::MatrixXd &X, Eigen::MatrixXd *F, NodeBlocks *K) {
+    return muscle_load(s, left, t, X, F, K) + muscle_load(s, right, t, X, F, K);
+  };
+  auto press = [&](bool contact, SolveStats *st) {
+    Eigen::MatrixXd X = s.X0;
+    SolverOptions so = m.solver;
+    so.lip_contact = contact;
+    FactorCache cache;
+    *st = solve_equilibrium(s, all_vertices(s), f, s.X0, X, so, &cache);
+    EXPECT_TRUE(st->converged) << st->message;
+    return X;
+  };
+  SolveStats free_st, met_st;
+  const Eigen::MatrixXd apart = press(false, &free_st), met = press(true, &met_st);
+  const double margin = kLipMargin * m.fapu.mns0;
+  double deepest_free = 0, deepest_met = 0;
+  for (const LipPair &p : s.lip_pairs) {
+    deepest_free = std::max(deepest_free, p.on - (apart(p.upper, 1) - apart(p.lower, 1)));
+    deepest_met = std::max(deepest_met, p.on - (met(p.upper, 1) - met(p.lower, 1)));
+  }
+  std::printf("lower lip pushed up: the deepest crossing %.2f margins without contact, %.2f with; "
+              "8.1 up %.3f mm against %.3f mm; %d against %d Newton iterations\n",
+              deepest_free / margin, deepest_met / margin, mm(moved(m, met, "8.1").y()),
+              mm(moved(m, apart, "8.1").y()), met_st.iterations, free_st.iterations);
+  ASSERT_GT(deepest_free, 2 * margin) << "the load must press the lips together";
+  EXPECT_LT(deepest_met, margin);
+  EXPECT_EQ(crossed_lip_pairs(s, met, margin), 0);
+  EXPECT_GT(moved(m, met, "8.1").y(), moved(m, apart, "8.1").y() + 0.5 * margin) << "the lower lip lifts the upper";
+  EXPECT_TRUE(met.allFinite());
+  EXPECT_EQ(inverted_elements(s, met), inverted_elements(s, apart));
+  // At the equilibrium the contact's forces balance: the residual with them
+  // is small, without them it is not.
+  const Eigen::MatrixXd with = residual_forces(s, all_vertices(s), f, s.X0, met, true);
+  const Eigen::MatrixXd without = residual_forces(s, all_vertices(s), f, s.X0, met, false);
+  double w = 0, wo = 0;
+  for (const LipPair &p : s.lip_pairs) {
+    w = std::max(w, with.row(p.upper).norm());
+    wo = std::max(wo, without.row(p.upper).norm());
+  }
+  EXPECT_LT(w, 0.01 * wo);
+}
+
 TEST(Physics, TheJawOpens) {
   const FaceModel &m = head_1k().model;
   Activation a;

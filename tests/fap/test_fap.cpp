@@ -558,6 +558,47 @@ TEST(HighLevel, TheVisemesPutTheTongueWherePhoneticsSays) {
   EXPECT_EQ(said.find("without the tongue", at + 1), std::string::npos) << said;
 }
 
+// The lips meet in a viseme (SolverOptions::lip_contact): /p, b, m/
+// (orbicularis oris and mentalis) presses them together, and no lip pair
+// (anatomy/lip_contact.h) crosses by more than its margin. FAP 5 moves the
+// lower lip alone, as MPEG-4 defines it: its target lifts the bottom lip's
+// middle (2.3) past the top one's rest place while the top lip (2.2) stays
+// (the player's sum with FAP 4's is the pressed lips).
+TEST(HighLevel, TheLipsMeetInAVisemeAndMoveAloneInAFapTarget) {
+  const Built &b = head_1k();
+  const SkinModel &skin = b.model.tissue;
+  FapSynthesisOptions o;
+  o.only = {5};
+  o.only_visemes = {1};
+  Expected<FapSynthesis> s = synthesize_faps(b.head.scene, b.model, o);
+  ASSERT_TRUE(s.is_ok()) << s.status().message();
+  const MorphTarget *pbm = nullptr, *raise = nullptr;
+  for (const MorphTarget &t : s->targets) {
+    if (t.kind == AFM_TARGET_VISEME && t.number == 1) pbm = &t;
+    if (t.kind == AFM_TARGET_FAP && t.number == 5 && t.reference > 0) raise = &t;
+  }
+  ASSERT_TRUE(pbm && raise);
+  ASSERT_FALSE(skin.lip_pairs.empty());
+  const double margin = kLipMargin * b.model.fapu.mns0;
+  auto deepest = [&](const MorphTarget &t) {
+    const Eigen::MatrixXd X = skin.X0.topRows(skin.n) + t.displacement[static_cast<size_t>(b.model.skin)];
+    double d = -1e9;
+    for (const LipPair &p : skin.lip_pairs) d = std::max(d, p.on - (X(p.upper, 1) - X(p.lower, 1)));
+    return d;
+  };
+  const double unit = b.model.fapu.mns0 / 1024.0;
+  const Eigen::Vector3d top = at_fdp(*raise, 2, 2), bottom = at_fdp(*raise, 2, 3);
+  std::printf("/p, b, m/: the lips cross by %.2f margins at most; FAP 5 at %d: 2.3 up %.1f units, 2.2 %.1f, "
+              "crossing %.1f margins\n",
+              deepest(*pbm) / margin, raise->reference, bottom.y() / unit, top.y() / unit, deepest(*raise) / margin);
+  EXPECT_LT(deepest(*pbm), margin);
+  EXPECT_GT(pbm->displacement[static_cast<size_t>(b.model.skin)].rowwise().norm().maxCoeff(), 3 * margin)
+      << "the viseme moves the lips";
+  EXPECT_GT(bottom.y(), 0.9 * raise->reference * unit);
+  EXPECT_LT(std::abs(top.y()), 0.1 * bottom.y()) << "the top lip stays";
+  EXPECT_GT(deepest(*raise), 10 * margin) << "the bottom lip passes the top one's rest place";
+}
+
 // Fear widens both pupils (fap_mapping.cpp: FAPs 29 and 30 at 200 IRISD
 // units in its table row): each eye's pupil diameter grows by 200 x IRISD0 /
 // 1024, and neither eye's white moves.
