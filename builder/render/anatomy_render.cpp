@@ -42,6 +42,7 @@ const Eigen::Vector3f kWhite(1.0f, 1.0f, 1.0f);
 const Eigen::Vector3f kRed(0.95f, 0.12f, 0.10f);
 const Eigen::Vector3f kGreen(0.12f, 0.82f, 0.22f);
 const Eigen::Vector3f kYellow(1.0f, 0.88f, 0.05f);
+const Eigen::Vector3f kMagenta(0.95f, 0.20f, 0.85f);
 const Eigen::Vector3f kOutline(0.07f, 0.07f, 0.07f);
 const Eigen::Vector3d kHiRed(0.90, 0.08, 0.06);
 const Eigen::Vector3d kHiGreen(0.10, 0.72, 0.18);
@@ -397,6 +398,16 @@ Status render_jaw_map_png(const Scene &scene, const FaceModel &model, const std:
   const double pivot_bias =
       std::max(xray_bias(pivot, skin.V(), scale, views), edge_bias + scale.step) + scale.step;
   add_outlined(markers, pivot, kYellow, kDotPixels + 2, pivot_bias, scale.step);
+  // The lips' contact pairs: both vertices of each (one dot where they
+  // coincide, as on a seam of cut lips).
+  std::vector<Eigen::Vector3d> lip_dots;
+  for (const LipPair &p : model.tissue.lip_pairs)
+    for (int g : {p.upper, p.lower}) lip_dots.push_back(model.tissue.X0.row(g).transpose());
+  if (!lip_dots.empty()) {
+    const Eigen::MatrixXd lips = rows_of(lip_dots);
+    add_outlined(markers, lips, kMagenta, kDotPixels - 3, std::max(xray_bias(lips, skin.V(), scale, views), pivot_bias),
+                 scale.step);
+  }
   return draw(s, model, std::move(markers), path, options);
 }
 
