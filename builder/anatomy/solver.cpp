@@ -66,7 +66,7 @@ struct System {
   std::vector<int> nodes;  // free nodes, global
   std::vector<int> local;  // global node -> local index, or -1
   std::vector<int> springs;
-  std::vector<int> lips;  // SkinModel::lip_pairs with a free node
+  std::vector<int> lips;  // SkinModel::lip_pairs with a free node, when in contact
   std::vector<Element> elements;
   std::vector<uint8_t> rejects;  // per local node: held above its skull plane
   std::vector<int8_t> eye;       // per local node: the eyeball (SkinModel::eyes) it is held off, or -1
@@ -93,7 +93,8 @@ struct System {
     return Block{pattern.outerIndexPtr()[3 * j] + 3 * static_cast<int>(pos), 3 * static_cast<int>(col.size())};
   }
 
-  System(const SkinModel &model, const std::vector<int> &vertices) : m(model) {
+  // With `contact`, the lip pairs with a free node join as ties.
+  System(const SkinModel &model, const std::vector<int> &vertices, bool contact) : m(model) {
     local.assign(static_cast<size_t>(kTissueLayers * m.n), -1);
     for (int v : vertices) {
       if (v < 0 || v >= m.n || !m.in_mesh[static_cast<size_t>(v)]) continue;
@@ -118,7 +119,7 @@ struct System {
           if (m.stiffness(m.springs[static_cast<size_t>(s)]) > 0) springs.push_back(s);
         }
     std::sort(springs.begin(), springs.end());
-    for (size_t p = 0; p < m.lip_pairs.size(); ++p) {
+    for (size_t p = 0; contact && p < m.lip_pairs.size(); ++p) {
       const LipPair &lp = m.lip_pairs[p];
       if (local[static_cast<size_t>(lp.upper)] >= 0 || local[static_cast<size_t>(lp.lower)] >= 0)
         lips.push_back(static_cast<int>(p));
@@ -312,7 +313,7 @@ void add_block(double *values, Block b, const M &B) {
 // d2V/dp2, leaving its Gauss-Newton part), which keeps K positive
 // semi-definite everywhere; `full`, Newton converges quadratically near an
 // equilibrium, where K is definite anyway.
-void linearise(const System &sys, bool contact, const Eigen::MatrixXd &X, SpMat &K, Vec &diag, bool full = false) {
+void linearise(const System &sys, const Eigen::MatrixXd &X, SpMat &K, Vec &diag, bool full = false) {
   const SkinModel &m = sys.m;
   if (K.nonZeros() != sys.pattern.nonZeros()) K = sys.pattern;
   double *val = K.valuePtr();
@@ -332,7 +333,7 @@ void linearise(const System &sys, bool contact, const Eigen::MatrixXd &X, SpMat 
     if (bl[2].base >= 0) add_block(val, bl[2], -B), add_block(val, bl[3], -B);
   }
   // Lip pairs: d2E/ds2 up up^T, up = +y (lip_contact.h).
-  for (size_t i = 0; contact && i < sys.lips.size(); ++i) {
+  for (size_t i = 0; i < sys.lips.size(); ++i) {
     const LipPair &p = m.lip_pairs[static_cast<size_t>(sys.lips[i])];
     const double c = lip_contact_energy(p, X(p.upper, 1) - X(p.lower, 1)).d2;
     if (c <= 0) continue;
@@ -415,7 +416,7 @@ void scatter_rows(const System &sys, const Vec &x, Eigen::MatrixXd &P) {
 }
 
 // Internal plus external force on the free nodes.
-void net_force(const System &sys, bool contact, const ForceField &forces, const Eigen::MatrixXd &ref,
+void net_force(const System &sys, const ForceField &forces, const Eigen::MatrixXd &ref,
                const Eigen::MatrixXd &X, Vec &r) {
   const SkinModel &m = sys.m;
   r.setZero(sys.dofs());
@@ -430,7 +431,7 @@ void net_force(const System &sys, bool contact, const ForceField &forces, const 
     if (la >= 0) r.segment<3>(3 * la) += f;
     if (lb >= 0) r.segment<3>(3 * lb) -= f;
   }
-  for (size_t i = 0; contact && i < sys.lips.size(); ++i) {
+  for (size_t i = 0; i < sys.lips.size(); ++i) {
     const LipPair &p = m.lip_pairs[static_cast<size_t>(sys.lips[i])];
     const double f = -lip_contact_energy(p, X(p.upper, 1) - X(p.lower, 1)).d1;  // pushes the upper vertex up
     if (f == 0) continue;
@@ -473,7 +474,7 @@ void net_force(const System &sys, bool contact, const ForceField &forces, const 
 }
 
 // Total potential energy of the system: springs, volume, external load.
-double total_energy(const System &sys, bool contact, const ForceField &forces, const Eigen::MatrixXd &ref,
+double total_energy(const System &sys, const ForceField &forces, const Eigen::MatrixXd &ref,
                     const Eigen::MatrixXd &X) {
   const SkinModel &m = sys.m;
   double e = 0;
@@ -481,7 +482,7 @@ double total_energy(const System &sys, bool contact, const ForceField &forces, c
     const Spring &s = m.springs[static_cast<size_t>(si)];
     e += spring_energy(s, m.stiffness(s), (X.row(s.b) - X.row(s.a)).norm());
   }
-  for (size_t i = 0; contact && i < sys.lips.size(); ++i) {
+  for (size_t i = 0; i < sys.lips.size(); ++i) {
     const LipPair &p = m.lip_pairs[static_cast<size_t>(sys.lips[i])];
     e += lip_contact_energy(p, X(p.upper, 1) - X(p.lower, 1)).e;
   }
@@ -695,13 +696,13 @@ struct FactorCache::Entry {
 
 FactorCache::FactorCache() = default;
 FactorCache::~FactorCache() = default;
-FactorCache::Entry *FactorCache::find(const std::vector<int> &vertices) const {
-  auto it = entries_.find(vertices);
+FactorCache::Entry *FactorCache::find(const std::vector<int> &vertices, bool lip_contact) const {
+  auto it = entries_.find({lip_contact, vertices});
   return it == entries_.end() ? nullptr : it->second.get();
 }
-FactorCache::Entry *FactorCache::insert(const std::vector<int> &vertices, std::unique_ptr<Entry> e) {
+FactorCache::Entry *FactorCache::insert(const std::vector<int> &vertices, bool lip_contact, std::unique_ptr<Entry> e) {
   Entry *raw = e.get();
-  entries_[vertices] = std::move(e);
+  entries_[{lip_contact, vertices}] = std::move(e);
   return raw;
 }
 void FactorCache::clear() { entries_.clear(); }
@@ -734,14 +735,14 @@ bool skull_rejects(const SkinModel &m, int v) {
 namespace {
 
 // The cached system of `vertices` (built and analysed on first use).
-FactorCache::Entry *entry_for(const SkinModel &model, const std::vector<int> &vertices, FactorCache *cache,
-                              std::unique_ptr<FactorCache::Entry> &own) {
+FactorCache::Entry *entry_for(const SkinModel &model, const std::vector<int> &vertices, bool lip_contact,
+                              FactorCache *cache, std::unique_ptr<FactorCache::Entry> &own) {
   if (cache)
-    if (FactorCache::Entry *e = cache->find(vertices); e && &e->sys->m == &model) return e;
+    if (FactorCache::Entry *e = cache->find(vertices, lip_contact); e && &e->sys->m == &model) return e;
   auto e = std::make_unique<FactorCache::Entry>();
-  e->sys = std::make_unique<System>(model, vertices);
+  e->sys = std::make_unique<System>(model, vertices, lip_contact);
   if (e->sys->dofs() > 0) e->analysed = e->symbolic.analyze(e->sys->pattern);
-  if (cache) return cache->insert(vertices, std::move(e));
+  if (cache) return cache->insert(vertices, lip_contact, std::move(e));
   own = std::move(e);
   return own.get();
 }
@@ -752,7 +753,7 @@ const Ldlt *rest_factor(FactorCache::Entry &e) {
     e.rest = std::make_unique<Ldlt>(e.symbolic);
     SpMat K;
     Vec diag;
-    linearise(*e.sys, false, e.sys->m.X0, K, diag);  // no contact at rest
+    linearise(*e.sys, e.sys->m.X0, K, diag);
     e.rest_ok = e.analysed && e.rest->factorize(K) != Ldlt::Result::kSingular;
   }
   return e.rest_ok ? e.rest.get() : nullptr;
@@ -762,10 +763,10 @@ const Ldlt *rest_factor(FactorCache::Entry &e) {
 
 Eigen::MatrixXd residual_forces(const SkinModel &model, const std::vector<int> &vertices,
                                 const ForceField &forces, const Eigen::MatrixXd &reference,
-                                const Eigen::MatrixXd &X, bool contact) {
-  System sys(model, vertices);
+                                const Eigen::MatrixXd &X, bool lip_contact) {
+  System sys(model, vertices, lip_contact);
   Vec r;
-  net_force(sys, contact, forces, reference, X, r);
+  net_force(sys, forces, reference, X, r);
   Eigen::MatrixXd out = Eigen::MatrixXd::Zero(X.rows(), 3);
   scatter_rows(sys, r, out);
   return out;
@@ -774,7 +775,7 @@ Eigen::MatrixXd residual_forces(const SkinModel &model, const std::vector<int> &
 Expected<Eigen::MatrixXd> linear_response(const SkinModel &model, const std::vector<int> &vertices,
                                           const ForceField &load, FactorCache *cache) {
   std::unique_ptr<FactorCache::Entry> own;
-  FactorCache::Entry *e = entry_for(model, vertices, cache, own);
+  FactorCache::Entry *e = entry_for(model, vertices, false, cache, own);
   Eigen::MatrixXd out = Eigen::MatrixXd::Zero(model.X0.rows(), 3);
   if (e->sys->dofs() == 0) return out;
   const Ldlt *rest = rest_factor(*e);
@@ -800,7 +801,6 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     return st;
   };
   const std::string name = solver_name(options.kind);
-  const bool contact = options.lip_contact;
   if (!(options.tolerance > 0)) return done(false, "solver: tolerance must be positive");
   if (control && options.kind == SolverKind::ImplicitEuler)
     return done(false, "solver: implicit-euler cannot solve for a tension (use a newton solver)");
@@ -808,7 +808,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     return done(false, "solver: a load control needs a unit load and an action");
   if (control) control->capped = control->unreachable = false;
   std::unique_ptr<FactorCache::Entry> own;
-  FactorCache::Entry *entry = entry_for(model, vertices, cache, own);
+  FactorCache::Entry *entry = entry_for(model, vertices, options.lip_contact, cache, own);
   const System &sys = *entry->sys;
   const int n = sys.dofs();
   st.unknowns = n;
@@ -828,15 +828,15 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     const int max_steps = options.max_iterations > 0 ? options.max_iterations : 2000;
     Vec mass(n);
     for (size_t i = 0; i < sys.nodes.size(); ++i) mass.segment<3>(3 * static_cast<int>(i)).setConstant(model.mass[sys.nodes[i]]);
-    linearise(sys, contact, X, K, diag);
+    linearise(sys, X, K, diag);
     const double t0 = std::sqrt(mass.mean() / std::max(diag.mean(), 1e-300));
     const double h = options.time_step * t0, gamma = options.damping / t0;
     add_load_stiffness(sys, forces, X, K, diag);
     Vec v = Vec::Zero(n), dv, Kv(n), b(n);
     for (int step = 0; step < max_steps; ++step) {
-      net_force(sys, contact, forces, reference, X, r);
+      net_force(sys, forces, reference, X, r);
       if (step > 0) {
-        linearise(sys, contact, X, K, diag);
+        linearise(sys, X, K, diag);
         add_load_stiffness(sys, forces, X, K, diag);
       }
       st.residual = displacement_estimate([&] { Vec f = r; contacts.filter(f); return f; }(), diag);
@@ -932,9 +932,9 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
   double known_energy = 0;
   for (int it = 0;; ++it) {
     const ForceField load = load_at(t);
-    net_force(sys, contact, load, reference, X, r);
+    net_force(sys, load, reference, X, r);
     if (!finite(r)) return done(false, name + ": non-finite force");
-    linearise(sys, contact, X, K, diag, true);
+    linearise(sys, X, K, diag, true);
     add_load_stiffness(sys, load, X, K, diag);
     Vec rf = r;
     contacts.filter(rf);
@@ -984,7 +984,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     // 1,424 -> 1,362; the same models and reports.
     bool full = true;
     auto project = [&] {
-      linearise(sys, contact, X, K, diag, full = false);
+      linearise(sys, X, K, diag, full = false);
       add_load_stiffness(sys, load, X, K, diag);
     };
     auto shifted = [&] {
@@ -1103,14 +1103,14 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     Vec rn = rf;
     if (control) rn += dt * [&] { Vec gf = g; contacts.filter(gf); return gf; }();
     x0 = gather_rows(sys, X);
-    const double e0 = energy_known ? known_energy : total_energy(sys, contact, next_load, reference, X);
+    const double e0 = energy_known ? known_energy : total_energy(sys, next_load, reference, X);
     const double slope = rn.dot(dx);
     double alpha = 1, e_trial = 0;
     Eigen::MatrixXd Xt = X;
     for (int ls = 0; ls < 12; ++ls) {
       trial = x0 + alpha * dx;
       scatter_rows(sys, trial, Xt);
-      e_trial = total_energy(sys, contact, next_load, reference, Xt);
+      e_trial = total_energy(sys, next_load, reference, Xt);
       if ((std::isfinite(e_trial) && e_trial <= e0 - 1e-4 * alpha * std::max(slope, 0.0)) || ls == 11) break;
       alpha *= 0.5;
     }
@@ -1124,7 +1124,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
       for (double longer : {2.0, 4.0, 8.0}) {
         const Vec further = x0 + longer * dx;
         scatter_rows(sys, further, Xt);
-        const double e = total_energy(sys, contact, next_load, reference, Xt);
+        const double e = total_energy(sys, next_load, reference, Xt);
         if (!(std::isfinite(e) && e < e_taken)) break;
         e_taken = e, trial = further, alpha = longer;
       }

@@ -189,7 +189,9 @@ using NodeBlocks = std::vector<std::pair<int, Eigen::Matrix3d>>;
 // lips toward its epicentre did, 400 iterations at a thirty-second of a step.
 using ForceField = std::function<double(const Eigen::MatrixXd &X, Eigen::MatrixXd *F, NodeBlocks *K)>;
 
-// Per dynamic set (and skin model): the unknowns, the Hessian's sparsity
+// Per dynamic set (and skin model) and lip contact (on or off: with it the
+// lip pairs join the pattern, and their coupling of the two lips costs
+// fill-in in every factorisation): the unknowns, the Hessian's sparsity
 // pattern, its fill-reducing ordering, and the rest-state factorisation once
 // a solver needed it; reused by every solve on the same set. Not
 // thread-safe: one cache per thread.
@@ -198,13 +200,13 @@ class FactorCache {
   FactorCache();
   ~FactorCache();
   struct Entry;
-  Entry *find(const std::vector<int> &vertices) const;
-  Entry *insert(const std::vector<int> &vertices, std::unique_ptr<Entry> e);
+  Entry *find(const std::vector<int> &vertices, bool lip_contact) const;
+  Entry *insert(const std::vector<int> &vertices, bool lip_contact, std::unique_ptr<Entry> e);
   size_t size() const { return entries_.size(); }
   void clear();
 
  private:
-  std::map<std::vector<int>, std::unique_ptr<Entry>> entries_;
+  std::map<std::pair<bool, std::vector<int>>, std::unique_ptr<Entry>> entries_;
 };
 
 // Solving for a tension as well (calibration): see "Load control" above.
