@@ -306,6 +306,14 @@ void add_block(double *values, Block b, const M &B) {
     for (int r = 0; r < 3; ++r) values[b.base + c * b.stride + r] += B(r, c);
 }
 
+// A tie's Hessian: B on its nodes' own blocks, -B between them (a fixed
+// node's blocks are not stored).
+void add_tie(double *values, const std::array<Block, 4> &bl, const Eigen::Matrix3d &B) {
+  if (bl[0].base >= 0) add_block(values, bl[0], B);
+  if (bl[1].base >= 0) add_block(values, bl[1], B);
+  if (bl[2].base >= 0) add_block(values, bl[2], -B), add_block(values, bl[3], -B);
+}
+
 // The Hessian at X into K (the system's pattern): springs, the shape term and
 // the volume term. `diag` gets its diagonal. Not `full` (the projected
 // tangent): the indefinite parts are dropped (a compressed spring's negative
@@ -327,10 +335,7 @@ void linearise(const System &sys, const Eigen::MatrixXd &X, SpMat &K, Vec &diag,
     tension(s, m.stiffness(s), l, &t, &dt);
     const double geo = (t >= 0 || full ? t : 0.0) / l;
     const Eigen::Matrix3d B = (dt - geo) * u * u.transpose() + geo * Eigen::Matrix3d::Identity();
-    const std::array<Block, 4> &bl = sys.tie_blocks[q];
-    if (bl[0].base >= 0) add_block(val, bl[0], B);
-    if (bl[1].base >= 0) add_block(val, bl[1], B);
-    if (bl[2].base >= 0) add_block(val, bl[2], -B), add_block(val, bl[3], -B);
+    add_tie(val, sys.tie_blocks[q], B);
   }
   // Lip pairs: d2E/ds2 up up^T, up = +y (lip_contact.h).
   for (size_t i = 0; i < sys.lips.size(); ++i) {
@@ -339,10 +344,7 @@ void linearise(const System &sys, const Eigen::MatrixXd &X, SpMat &K, Vec &diag,
     if (c <= 0) continue;
     Eigen::Matrix3d B = Eigen::Matrix3d::Zero();
     B(1, 1) = c;
-    const std::array<Block, 4> &bl = sys.tie_blocks[sys.springs.size() + i];
-    if (bl[0].base >= 0) add_block(val, bl[0], B);
-    if (bl[1].base >= 0) add_block(val, bl[1], B);
-    if (bl[2].base >= 0) add_block(val, bl[2], -B), add_block(val, bl[3], -B);
+    add_tie(val, sys.tie_blocks[sys.springs.size() + i], B);
   }
   Eigen::Matrix<double, 9, 3> g, gs[3];
   VolumeHessian H;
