@@ -40,6 +40,7 @@ std::vector<LipPair> lip_pairs(const SkinModel &m, const std::vector<int> &upper
   // One above the other, the upper vertex not below the lower one.
   std::vector<std::pair<int, int>> kept;
   for (const auto &[a, b] : found) {
+    if (a == b) continue;  // a vertex both searches reached (round a mouth corner)
     const Eigen::Vector3d d = at(a) - at(b);
     const double side = std::hypot(d.x(), d.z());
     if (d.y() >= 0 && side <= std::max(kLipPairSlant * d.y(), margin)) kept.emplace_back(a, b);

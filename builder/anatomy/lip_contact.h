@@ -52,10 +52,11 @@ struct LipContactValue {
 };
 LipContactValue lip_contact_energy(const LipPair &p, double s);
 
-// The pairs of `upper` and `lower` (skin vertex sets, sorted, disjoint) on
-// the rest state of `m`, with contact modulus `modulus` (> 0), `band` and
-// `margin` in model units (> 0). A vertex in several pairs shares its area
-// among them. Ordered by upper vertex, then lower.
+// The pairs of `upper` and `lower` (skin vertex sets, sorted; a vertex both
+// hold is never paired with itself) on the rest state of `m`, with contact
+// modulus `modulus` (> 0), `band` and `margin` in model units (> 0). A vertex
+// in several pairs shares its area among them. Ordered by upper vertex, then
+// lower.
 std::vector<LipPair> lip_pairs(const SkinModel &m, const std::vector<int> &upper, const std::vector<int> &lower,
                                double modulus, double band, double margin);
 

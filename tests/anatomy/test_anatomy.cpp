@@ -849,6 +849,15 @@ TEST(LipContact, OnTheReferenceHeadThePairsAreTheLipSeam) {
   EXPECT_EQ(pairs, seam);
   // Nothing of it at rest.
   EXPECT_EQ(crossed_lip_pairs(s, s.X0, 0.0), 0);
+  // A vertex both searches reached (round a mouth corner) is never paired
+  // with itself.
+  std::vector<int> both = lips->upper;
+  both.insert(both.end(), lips->lower.begin(), lips->lower.begin() + 3);
+  std::sort(both.begin(), both.end());
+  const std::vector<LipPair> again =
+      lip_pairs(s, both, lips->lower, 1.0, kLipBand * m.fapu.mns0, kLipMargin * m.fapu.mns0);
+  EXPECT_GE(again.size(), seam.size());
+  for (const LipPair &p : again) EXPECT_NE(p.upper, p.lower);
 }
 
 // Both mentalis muscles push the lower lip up into the upper one. Without
