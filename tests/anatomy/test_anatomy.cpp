@@ -873,9 +873,10 @@ TEST(Physics, PressedLipsMeetAndDoNotPassIntoEachOther) {
   ForceField f = [&](const Eigen::MatrixXd &X, Eigen::MatrixXd *F, NodeBlocks *K) {
     return muscle_load(s, left, t, X, F, K) + muscle_load(s, right, t, X, F, K);
   };
-  auto press = [&](bool contact, SolveStats *st) {
+  auto press = [&](bool contact, SolveStats *st, SolverKind kind = SolverKind::Newton) {
     Eigen::MatrixXd X = s.X0;
     SolverOptions so = m.solver;
+    so.kind = kind;
     so.lip_contact = contact;
     FactorCache cache;
     *st = solve_equilibrium(s, all_vertices(s), f, s.X0, X, so, &cache);
@@ -910,6 +911,13 @@ TEST(Physics, PressedLipsMeetAndDoNotPassIntoEachOther) {
     wo = std::max(wo, without.row(p.upper).norm());
   }
   EXPECT_LT(w, 0.01 * wo);
+  // Every solver takes the contact: the same equilibrium, each within its
+  // tolerance (allow a few).
+  for (SolverKind kind : {SolverKind::NewtonRest, SolverKind::ImplicitEuler, SolverKind::NewtonJacobi}) {
+    SolveStats st;
+    const Eigen::MatrixXd other = press(true, &st, kind);
+    EXPECT_LT((other - met).cwiseAbs().maxCoeff(), 10 * m.solver.tolerance) << solver_name(kind);
+  }
 }
 
 TEST(Physics, TheJawOpens) {
