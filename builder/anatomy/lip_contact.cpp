@@ -52,7 +52,7 @@ std::vector<LipPair> lip_pairs(const SkinModel &m, const std::vector<int> &upper
     LipPair p;
     p.upper = m.node(kEpidermis, a);
     p.lower = m.node(kEpidermis, b);
-    p.on = std::min(at(a).y() - at(b).y(), margin);
+    p.on = 0;  // contact where the upper vertex comes down to the lower one's height
     p.margin = margin;
     p.stiffness = modulus * (m.area[a] / count[static_cast<size_t>(a)] + m.area[b] / count[static_cast<size_t>(b)]) / 2;
     pairs.push_back(p);

@@ -12,8 +12,9 @@
 //
 // Per pair, with s = (x_upper - x_lower) . up the height of the upper
 // vertex over the lower one (up: +y, the MPEG-4 frame's), contact begins
-// at s_on = min(s0, margin) (s0 the rest height: lips that touch at rest are
-// in contact at once, lips apart may close to the margin first) and
+// at s_on (lip_pairs: 0, where the upper vertex comes down to the lower
+// one's height; lips apart at rest close fully, and pressed they overlap by
+// a fraction of a margin, hidden where they meet) and
 //   E = k margin u^3 / 3,   u = (s_on - s) / margin,   for u > 0 (0 otherwise),
 //   force on the upper vertex  k u^2 up (the lower: the opposite),
 //   Hessian                    2 k u / margin [up; -up] [up; -up]^T,
@@ -40,7 +41,7 @@ constexpr double kLipMargin = 0.02;
 
 struct LipPair {
   int upper = -1, lower = -1;  // epidermal nodes (global node indices)
-  double on = 0;               // s_on, model units (<= the rest height)
+  double on = 0;               // s_on, model units (<= the rest height; lip_pairs: 0)
   double margin = 0;           // model units, > 0
   double stiffness = 0;        // k, force units
 };
