@@ -500,14 +500,8 @@ Status place_turned_lid(const FaceModel &model, const LidTurn &lid, Eigen::Matri
   for (int v = 0; v < skin.n; ++v) {
     if (!tarsus[static_cast<size_t>(v)] || skin.eye_near[static_cast<size_t>(v)] != m.eye) continue;
     const int g = skin.node(kEpidermis, v);
-    double grown = 0;
-    for (int u : skin.neighbours[static_cast<size_t>(v)])
-      if (tarsus[static_cast<size_t>(u)] && skin.eye_near[static_cast<size_t>(u)] == m.eye)
-        grown = std::max(grown, (turned.row(g) - turned.row(skin.node(kEpidermis, u))).squaredNorm() -
-                                    (skin.X0.row(g) - skin.X0.row(skin.node(kEpidermis, u))).squaredNorm());
     const Eigen::Vector3d d = Eigen::Vector3d(turned.row(g)) - ball.centre;
-    const double least =
-        ball.radius + skin.eye_clearance[static_cast<size_t>(v)] + kChordDip * grown / ball.radius + lid.clearance;
+    const double least = ball.radius + eye_clearance_in(skin, v, turned, &tarsus) + lid.clearance;
     if (d.norm() < least) X.row(g) = (ball.centre + d.normalized() * least).transpose();
   }
   return Status::ok();

@@ -112,12 +112,12 @@ std::vector<int8_t> over_eyeballs(const Eigen::MatrixXd &V, const Eigen::MatrixX
 
 }  // namespace
 
-double eye_clearance_in(const SkinModel &m, int v, const Eigen::MatrixXd &X) {
+double eye_clearance_in(const SkinModel &m, int v, const Eigen::MatrixXd &X, const std::vector<char> *among) {
   const int8_t eye = m.eye_near[static_cast<size_t>(v)];
   const Eigen::RowVector3d x = X.row(m.node(kEpidermis, v)), x0 = m.X0.row(v);
   double grown = 0;
   for (int u : m.neighbours[static_cast<size_t>(v)])
-    if (m.eye_near[static_cast<size_t>(u)] == eye)
+    if (m.eye_near[static_cast<size_t>(u)] == eye && (!among || (*among)[static_cast<size_t>(u)]))
       grown = std::max(grown, (x - X.row(m.node(kEpidermis, u))).squaredNorm() - (x0 - m.X0.row(u)).squaredNorm());
   return m.eye_clearance[static_cast<size_t>(v)] + kChordDip * grown / m.eyes[static_cast<size_t>(eye)].radius;
 }

@@ -189,10 +189,12 @@ void hold_off_eyeball(SkinModel &m, int v, int eye);
 // node in pose X (4n x 3; v must have eye_near[v] >= 0), model units:
 // eye_clearance[v] plus what the chords to its neighbours held by the same
 // eyeball dip further as they stretch, kChordDip (l^2 - l0^2) / r for the
-// longest growth. A closing lid stretches: on the 2k
+// longest growth (`among`, when given, one flag per skin vertex: only the
+// chords to the neighbours flagged). A closing lid stretches: on the 2k
 // head its triangles grew to 11 mm over a 12.2 mm eyeball, and held at their
 // rest clearance the eye part showed through them.
-double eye_clearance_in(const SkinModel &m, int v, const Eigen::MatrixXd &X);
+double eye_clearance_in(const SkinModel &m, int v, const Eigen::MatrixXd &X,
+                        const std::vector<char> *among = nullptr);
 
 // The eyeballs of a scene: a sphere fitted to each eye part (left, then
 // right; an eye part whose vertices are not a sphere, within a tenth of its
