@@ -182,15 +182,19 @@ NodeDisplacement displacement(const Eigen::MatrixXd &X, const Eigen::MatrixXd &r
   return out;
 }
 
-// The rest state with the jaw's vertices (every layer) moved by `jaw`.
+// The rest state with the jaw's vertices (every layer) moved by `jaw`, and
+// its followers by their shares of it (jaw.h).
 Eigen::MatrixXd carried_rest(const FaceModel &model, const Eigen::Affine3d &jaw) {
   const SkinModel &skin = model.tissue;
   Eigen::MatrixXd X = skin.X0;
-  for (int v : model.jaw.vertices)
+  auto carry = [&](int v, const Eigen::Affine3d &motion) {
     for (int l = 0; l < kTissueLayers; ++l) {
       const int g = skin.node(l, v);
-      X.row(g) = (jaw * Eigen::Vector3d(skin.X0.row(g))).transpose();
+      X.row(g) = (motion * Eigen::Vector3d(skin.X0.row(g))).transpose();
     }
+  };
+  for (int v : model.jaw.vertices) carry(v, jaw);
+  for (const auto &[v, share] : model.jaw.followers) carry(v, jaw_share(model.jaw, jaw, share));
   return X;
 }
 
@@ -542,15 +546,21 @@ Expected<Pose> solve_pose(const FaceModel &model, const Activation &a, FactorCac
     // Its free nodes as the first guess; the skull nodes (fixed) stay this
     // pose's own, exactly.
     join(set, from->dynamic);
-    const Eigen::Affine3d carry = pose.jaw * from->jaw.inverse();
-    std::vector<char> on_jaw(static_cast<size_t>(skin.n), 0);
-    for (int v : model.jaw.vertices) on_jaw[static_cast<size_t>(v)] = 1;
-    for (int v : from->dynamic)
+    // Carried from its jaw motion to this one's: the jaw's vertices whole,
+    // the followers by their shares.
+    std::vector<double> share(static_cast<size_t>(skin.n), 0.0);
+    for (int v : model.jaw.vertices) share[static_cast<size_t>(v)] = 1;
+    for (const auto &[v, w] : model.jaw.followers) share[static_cast<size_t>(v)] = w;
+    for (int v : from->dynamic) {
+      const double w = share[static_cast<size_t>(v)];
+      const Eigen::Affine3d carry = w == 0 ? Eigen::Affine3d::Identity()
+                                  : w == 1 ? pose.jaw * from->jaw.inverse()
+                                           : jaw_share(model.jaw, pose.jaw, w) * jaw_share(model.jaw, from->jaw, w).inverse();
       for (int l = 0; l < kSkull; ++l) {
         const int g = skin.node(l, v);
-        const Eigen::Vector3d x = from->X.row(g).transpose();
-        pose.X.row(g) = (on_jaw[static_cast<size_t>(v)] ? Eigen::Vector3d(carry * x) : x).transpose();
+        pose.X.row(g) = (carry * Eigen::Vector3d(from->X.row(g).transpose())).transpose();
       }
+    }
   }
   for (const auto &[g, x] : placed) pose.X.row(g) = x.transpose();
   if (set.empty() && !options.whole_mesh) return pose;
@@ -633,8 +643,10 @@ SkinFaults skin_faults(const FaceModel &model, const Eigen::MatrixXd &E) {
     }
   }
   out.stretched_share = total > 0 ? stretched / total : 0;
+  // The jaw's bone moves under its vertices and, in part, its followers'.
   std::vector<char> on_jaw(static_cast<size_t>(s.n), 0);
   for (int v : model.jaw.vertices) on_jaw[static_cast<size_t>(v)] = 1;
+  for (const auto &f : model.jaw.followers) on_jaw[static_cast<size_t>(f.first)] = 1;
   for (int v = 0; v < s.n; ++v) {
     if (on_jaw[static_cast<size_t>(v)] || !s.in_mesh[static_cast<size_t>(v)] || !skull_rejects(s, v)) continue;
     const Eigen::Vector3d skull = s.X0.row(s.node(kSkull, v));

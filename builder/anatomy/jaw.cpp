@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <queue>
 
 #include "anatomy/muscles.h"
 #include "core/ray_triangle.h"
@@ -86,6 +87,42 @@ Expected<Jaw> build_jaw(const SkinModel &skin, const FdpSet &fdps, const Fapu &f
   jaw.vertices = std::move(merged);
   if (jaw.vertices.empty()) return Status::error("jaw: no skin vertex maps to the jaw");
 
+  // The followers: Dijkstra along the skin's edges from the jaw's vertices,
+  // through skin below the jaw line only.
+  std::vector<std::pair<double, double>> line;  // the lower row's (x, y), ascending in x
+  for (const Eigen::Vector3d &b : bottom) line.emplace_back(b.x(), b.y());
+  std::sort(line.begin(), line.end());
+  auto line_y = [&](double x) {
+    if (x <= line.front().first) return line.front().second;
+    if (x >= line.back().first) return line.back().second;
+    size_t k = 1;
+    while (line[k].first < x) ++k;
+    const auto &[x0, y0] = line[k - 1];
+    const auto &[x1, y1] = line[k];
+    return x1 > x0 ? y0 + (y1 - y0) * (x - x0) / (x1 - x0) : std::min(y0, y1);
+  };
+  const double band = kJawFollowBand * fapu.mw0;
+  std::vector<double> dist(static_cast<size_t>(skin.n), band);
+  using Item = std::pair<double, int>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> front;
+  for (int v : jaw.vertices) dist[static_cast<size_t>(v)] = 0, front.push({0.0, v});
+  while (!front.empty()) {
+    const auto [d, v] = front.top();
+    front.pop();
+    if (d > dist[static_cast<size_t>(v)]) continue;
+    for (int u : skin.neighbours[static_cast<size_t>(v)]) {
+      if (!skin.in_mesh[static_cast<size_t>(u)] || std::binary_search(upper.begin(), upper.end(), u) ||
+          skin.X0(u, 1) >= line_y(skin.X0(u, 0)))
+        continue;
+      const double du = d + (skin.X0.row(u) - skin.X0.row(v)).norm();
+      if (du < dist[static_cast<size_t>(u)]) dist[static_cast<size_t>(u)] = du, front.push({du, u});
+    }
+  }
+  for (int v = 0; v < skin.n; ++v) {
+    const double d = dist[static_cast<size_t>(v)];
+    if (d > 0 && d < band) jaw.followers.emplace_back(v, 0.5 * (1 + std::cos(3.14159265358979323846 * d / band)));
+  }
+
   jaw.pivot = Eigen::Vector3d(0, (P("5.3").y() + P("5.4").y()) / 2, (P("2.13").z() + P("2.14").z()) / 2);
   jaw.axis = Eigen::Vector3d::UnitX();
   jaw.max_open = 20.0 * 3.14159265358979323846 / 180.0;
@@ -98,6 +135,20 @@ Expected<Jaw> build_jaw(const SkinModel &skin, const FdpSet &fdps, const Fapu &f
   const Eigen::Vector3d turned = jaw.pivot + Eigen::AngleAxisd(jaw.max_open, jaw.axis) * (chin - jaw.pivot);
   jaw.open_glide = std::max(0.0, chin.z() - turned.z());
   return jaw;
+}
+
+Eigen::Affine3d jaw_share(const Jaw &jaw, const Eigen::Affine3d &motion, double share) {
+  // motion = T(t) T(pivot) R T(-pivot): t = motion(pivot) - pivot, and R's
+  // angle about the jaw's axis (signed: the axis is fixed).
+  const Eigen::AngleAxisd turn(motion.linear());
+  const double angle = turn.angle() * (turn.axis().dot(jaw.axis) < 0 ? -1 : 1);
+  const Eigen::Vector3d t = motion * jaw.pivot - jaw.pivot;
+  Eigen::Affine3d out = Eigen::Affine3d::Identity();
+  out.translate(share * t);
+  out.translate(jaw.pivot);
+  out.rotate(Eigen::AngleAxisd(share * angle, jaw.axis));
+  out.translate(-jaw.pivot);
+  return out;
 }
 
 Eigen::MatrixXd moved_points(const Eigen::Affine3d &motion, const Eigen::MatrixXd &V) {

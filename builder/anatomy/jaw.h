@@ -18,6 +18,17 @@
 // chin's lowest point, higher), then the underside (facing within 30
 // degrees of straight down), not the neck.
 //
+// Followers: the skin below the jaw line next to the jaw's vertices (the
+// underside of the chin and the throat, over the floor of the mouth, whose
+// soft tissue spans from the mandible to the hyoid) takes a share of the
+// jaw's motion, falling smoothly from 1 at the jaw's vertices to 0 at
+// kJawFollowBand x MW0 along the skin: 0.5 (1 + cos(pi d / band)) at
+// distance d. Without them the bone under the skin turned with the jaw up to
+// its last vertex and stayed put from the next on: an opening jaw folded the
+// skin under the chin into spikes along that line (the 2,000-vertex head's
+// demo). "Below the jaw line": under the polyline of the jaw mesh's lower
+// row through the FDPs, in x and y; never the upper lip.
+//
 // Motion: rotation about the condyles' axis, +x through the pivot
 //   pivot = (0, mean of 5.3.y and 5.4.y, mean of 2.13.z and 2.14.z),
 // the cheekbones' height and the jaw corners' depth; positive angles open
@@ -53,6 +64,10 @@ struct Jaw {
   double max_open = 0;              // radians at 100 %
   double max_thrust = 0, max_shift = 0;  // model units at 100 %
   double open_glide = 0;            // forward translation at 100 % opening, model units
+  // Vertices below the jaw line that take a share of its motion (see
+  // "Followers" above): (vertex, share), 0 < share < 1, sorted by vertex,
+  // none of them in `vertices`.
+  std::vector<std::pair<int, double>> followers;
   std::vector<int> dynamic;         // V_d of a full opening, sorted
   // The calibrated pose of a full opening, from the rest carried by the
   // jaw (face_model.h: a first guess for poses that open it).
@@ -65,6 +80,13 @@ Expected<Jaw> build_jaw(const SkinModel &skin, const FdpSet &fdps, const Fapu &f
 
 // The rigid motion for opening, thrust and shift in percent (open >= 0).
 Eigen::Affine3d jaw_motion(const Jaw &jaw, double open_pct, double thrust_pct, double shift_pct);
+
+// How far the followers reach along the skin, in mouth widths (MW0).
+constexpr double kJawFollowBand = 1.0;
+
+// The share `share` (0..1) of a jaw motion made by jaw_motion(): the same
+// axis and pivot, the angle and the translation times `share`.
+Eigen::Affine3d jaw_share(const Jaw &jaw, const Eigen::Affine3d &motion, double share);
 
 // The points V (#V x 3, model units) moved by `motion`: #V x 3.
 Eigen::MatrixXd moved_points(const Eigen::Affine3d &motion, const Eigen::MatrixXd &V);

@@ -368,8 +368,12 @@ Status render_jaw_map_png(const Scene &scene, const FaceModel &model, const std:
                       jaw.ray_hits.end(), std::back_inserter(added));
   std::set_difference(jaw.ray_hits.begin(), jaw.ray_hits.end(), jaw.vertices.begin(),
                       jaw.vertices.end(), std::back_inserter(removed));
-  const Scene s =
-      painted(scene, model, {{&kept, kHiViolet}, {&added, kHiCyan}, {&removed, kHiOrange}});
+  Scene s = painted(scene, model, {{&kept, kHiViolet}, {&added, kHiCyan}, {&removed, kHiOrange}});
+  // The followers in violet by their share of the jaw's motion.
+  Eigen::MatrixXd &colour = s.parts[model.skin].C;
+  for (const auto &[v, share] : jaw.followers)
+    if (v >= 0 && v < colour.rows())
+      colour.row(v) = ((1 - share) * kSkinTone + share * kHiViolet).transpose();
 
   const Epidermis skin(model.tissue);
   const Scale scale = picture_scale(skin.V());

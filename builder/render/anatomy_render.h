@@ -34,8 +34,10 @@ Status render_influence_png(const Scene &scene, const FaceModel &model, int musc
 
 // The jaw: skin vertices carried by the jaw blue-violet (those the segments
 // hit and the breadth-first fix kept), vertices the fix added cyan, ray hits
-// it removed orange; the jaw mesh's edges (white) and its pivot (yellow); the
-// lips' contact pairs (SkinModel::lip_pairs) as magenta dots.
+// it removed orange; its followers (Jaw::followers) blue-violet blended
+// into the skin tone by their share; the jaw mesh's edges (white) and its
+// pivot (yellow); the lips' contact pairs (SkinModel::lip_pairs) as magenta
+// dots.
 Status render_jaw_map_png(const Scene &scene, const FaceModel &model, const std::string &path,
                           const AnatomyPictureOptions &options = {});
 

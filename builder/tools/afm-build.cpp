@@ -67,7 +67,8 @@ void usage(FILE *out) {
       "  --influence MUSCLE FILE.png\n"
       "                          one muscle's influence area red and the nodes its elastic\n"
       "                          wave moves green (repeatable)\n"
-      "  --jaw-map FILE.png      skin carried by the jaw, the jaw mesh and its pivot,\n"
+      "  --jaw-map FILE.png      skin carried by the jaw (violet; paler below it, where\n"
+      "                          the skin follows in part), the jaw mesh and its pivot,\n"
       "                          the lips' contact pairs\n"
       "  --contract MUSCLE=PCT   contract a muscle, -100..100 %% of its calibrated range\n"
       "                          (repeatable; positive is the muscle's action)\n"
@@ -382,8 +383,8 @@ int main(int argc, char **argv) {
   }
   const Jaw &j = model->jaw;
   std::printf("jaw: %zu skin vertices (%zu ray hits, %d removed and %d added by the mouth-window search), "
-              "V_d %zu, pivot (%.4g %.4g %.4g)\n",
-              j.vertices.size(), j.ray_hits.size(), j.removed, j.added, j.dynamic.size(), j.pivot.x(),
+              "%zu below them follow in part, V_d %zu, pivot (%.4g %.4g %.4g)\n",
+              j.vertices.size(), j.ray_hits.size(), j.removed, j.added, j.followers.size(), j.dynamic.size(), j.pivot.x(),
               j.pivot.y(), j.pivot.z());
   std::printf("built in %.2f s\n", seconds);
 

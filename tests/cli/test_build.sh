@@ -140,7 +140,7 @@ echo "$drops" | awk '{ exit !($1 > 0.003 && $3 > 0.5 * $1 && $2 < 0.1 * $1) }' |
   fail "a placement run failed: $(cat "$tmp/out.txt")"
 grep -q "^skin: part 'skin', [0-9]* vertices" "$tmp/out.txt" || fail "no skin summary"
 grep -q "^orbicularis_oris " "$tmp/out.txt" || fail "no muscle table"
-grep -q "^jaw: .* skin vertices" "$tmp/out.txt" || fail "no jaw summary"
+grep -q "^jaw: .* skin vertices .*, [1-9][0-9]* below them follow in part" "$tmp/out.txt" || fail "no jaw summary with its followers"
 grep -q "^  lips: [1-9][0-9]* vertex pairs" "$tmp/out.txt" || fail "no lip contact pairs in the summary"
 for p in map zyg jaw; do
   sig=$(od -An -tx1 -N8 "$tmp/$p.png" 2>/dev/null | tr -d ' \n')
