@@ -265,12 +265,14 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
     model.muscles.push_back(std::move(*m));
   }
   // Section 3.2.1: the mouth-window searches take the other lip out of the
-  // mentalis and upper lip areas.
+  // mentalis and upper lip areas, and out of each lip protrusion driver's.
   Expected<MouthLips> lips = mouth_lips(model.tissue, model.fdps);
   if (!lips) return lips.status();
   for (Muscle &m : model.muscles) {
     if (m.name.rfind("mentalis", 0) == 0) remove_from_influence(m, lips->upper);
     if (m.name.rfind("upper_lip", 0) == 0) remove_from_influence(m, lips->lower);
+    if (m.name == "lip_protrusion_lower") remove_from_influence(m, lips->upper);
+    if (m.name == "lip_protrusion_upper") remove_from_influence(m, lips->lower);
   }
   // The lips' contact pairs, from the same searches.
   if (model.tissue.params.lip_contact_modulus > 0)

@@ -26,7 +26,8 @@
 
 namespace afmb {
 
-// Every FDP the 25 muscles and the jaw use.
+// Every FDP the muscles (muscle_table(): the paper's 25 and our drivers) and
+// the jaw use.
 std::vector<FdpId> anatomy_fdps();
 
 // The template: 82 FDPs (all but 7.1 and 11.5, which are not surface points)

@@ -13,7 +13,7 @@ using L = PullLine;
 
 // name, kind, attachment | semi-major end, insertion | semi-minor end, epicentre,
 // width, sense, max, min, calibrate_minor, skull_free, essential, line[, the
-// lid's corners].
+// lid's corners[, whole_thickness]].
 // Decisions where the paper's tables slip (docs/anatomy.md):
 //  - frontalis_inner_right: the paper writes 11.3 (the left hairline) in its
 //    attachment; every other right frontalis uses 11.2, so 11.2 here.
@@ -72,6 +72,15 @@ const std::vector<MuscleDef> kTable = {
     {"palpebral_upper_right", K::Lid, "3.2", "3.4", nullptr, 0, +1, 0.90, 0.25, false, true, false, L::Skull, "3.8", "3.12"},
     {"palpebral_lower_left", K::Lid, "3.3", "3.1", nullptr, 0, +1, 0.50, 0.15, false, true, false, L::Skull, "3.7", "3.11"},
     {"palpebral_lower_right", K::Lid, "3.4", "3.2", nullptr, 0, +1, 0.50, 0.15, false, true, false, L::Skull, "3.8", "3.12"},
+    // The lips pushed out (not in the paper; docs/anatomy.md "Lip
+    // protrusion"): each lip's middle pushed from a point behind it, offset
+    // from the lip by half the way from the lower lip's middle (2.3) to the
+    // midpoint of the jaw's corners (2.13, 2.14): about MW0 back and a little
+    // down (on a closed mouth, where 2.2 and 2.3 meet, the two fibres are
+    // parallel). A push, like mentalis' (sense -1, PullLine Key); +100 %
+    // moves the lip 15 % of the fibre out (about MW0 / 7).
+    {"lip_protrusion_upper", K::Linear, "2.2 + 1/4 (2.13 - 2.3) + 1/4 (2.14 - 2.3)", "1/2 (2.2 + 8.1)", nullptr, 0.20, -1, 0.15, 0.05, false, true, false, L::Key, nullptr, nullptr, true},
+    {"lip_protrusion_lower", K::Linear, "2.3 + 1/4 (2.13 - 2.3) + 1/4 (2.14 - 2.3)", "1/2 (2.3 + 8.2)", nullptr, 0.20, -1, 0.15, 0.05, false, true, false, L::Key, nullptr, nullptr, true},
 };
 
 struct Parser {

@@ -32,13 +32,16 @@ template <class Direction>
 double dead_load(const SkinModel &skin, const Muscle &m, double c, const Direction &direction,
                  const Eigen::MatrixXd &X, Eigen::MatrixXd *F) {
   double energy = 0;
-  for (size_t i = 0; i < m.influence.size(); ++i) {
-    const int node = skin.node(m.force_layer, m.influence[i]);
-    const Eigen::Vector3d x0 = skin.X0.row(node);
-    const Eigen::Vector3d u = direction(m.influence[i], x0);
-    energy -= c * m.weight[i] * (X.row(node).transpose() - x0).dot(u);
-    if (F) F->row(node) += (c * m.weight[i]) * u.transpose();
-  }
+  const int first = m.whole_thickness ? kEpidermis : m.force_layer, last = m.whole_thickness ? kHypodermis : m.force_layer;
+  const double share = 1.0 / (last - first + 1);
+  for (size_t i = 0; i < m.influence.size(); ++i)
+    for (int layer = first; layer <= last; ++layer) {
+      const int node = skin.node(layer, m.influence[i]);
+      const Eigen::Vector3d x0 = skin.X0.row(node);
+      const Eigen::Vector3d u = direction(m.influence[i], x0);
+      energy -= c * share * m.weight[i] * (X.row(node).transpose() - x0).dot(u);
+      if (F) F->row(node) += (c * share * m.weight[i]) * u.transpose();
+    }
   return energy;
 }
 
@@ -250,6 +253,7 @@ Expected<Muscle> place_muscle(const SkinModel &skin, const FdpSet &fdps, int def
 
   if (d.kind == MuscleKind::Linear) {
     m.force_layer = kDermis;
+    m.whole_thickness = d.whole_thickness;
     m.node_a = key_node(skin, fdps, kSkull, keys[0], m.key_a);
     m.node_b = key_node(skin, fdps, kDermis, keys[1], m.key_b);
     const Eigen::Vector3d a = skin.X0.row(m.node_a), b = skin.X0.row(m.node_b);

@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <string>
 
+#include "anatomy/muscle_table.h"
+
 namespace afmb {
 
 namespace {
@@ -53,8 +55,8 @@ std::vector<FapMapping> make_table() {
   }
   add(14, D::JawThrust, 30, {}, {}, "the jaw's forward translation");
   add(15, D::JawShift, 40, {}, {}, "the jaw's sideways translation");
-  add(16, D::Muscles, 40, {{"orbicularis_oris", 100}}, {{"orbicularis_oris", -100}}, "pursing pushes the lips out");
-  add(17, D::Muscles, 30, {{"orbicularis_oris", 100}}, {{"orbicularis_oris", -100}}, "pursing pushes the lips out");
+  add(16, D::Muscles, 40, {{"lip_protrusion_lower", 100}}, {{"lip_protrusion_lower", -100}}, "the lower lip pushed out");
+  add(17, D::Muscles, 30, {{"lip_protrusion_upper", 100}}, {{"lip_protrusion_upper", -100}}, "the upper lip pushed out");
   add(18, D::Muscles, 300, {{"mentalis_left", 100}, {"mentalis_right", 100}},
       {{"mentalis_left", -100}, {"mentalis_right", -100}}, "mentalis lifts the chin's skin");
   // ---- group 3: eyelids, eyeballs, pupils ----
@@ -155,18 +157,22 @@ std::vector<FapMapping> make_table() {
     help(61 + k, {"upper_lip_" + side, "zygomaticus_minor_" + side});
   }
   help(63, {"upper_lip_left", "upper_lip_right"});
+  // The lips pushed out: mentalis and upper lip hold each lip's middle level.
+  help(16, {"mentalis_left", "mentalis_right"});
+  help(17, {"upper_lip_left", "upper_lip_right"});
   return t;
 }
 
 // Visemes and expressions. Muscles by pair name ("zygomaticus_major" is
-// both sides); the signs as above: a negative upper lip raises the upper
+// both sides) or by their own (orbicularis oris, each lip's protrusion
+// driver); the signs as above: a negative upper lip raises the upper
 // lip, a negative orbicularis oculi widens the eye. Jaw openings in FAP 3
 // units (the table's reference, wide open, is 320). Mentalis, the chin
 // raiser (AU 17), presses the lower lip up.
 std::vector<HighLevelMapping> make_high_level_table() {
   std::vector<HighLevelMapping> t;
   struct Pair {
-    const char *muscle;  // a pair name (both sides) or a single muscle's
+    const char *muscle;  // a muscle's name (muscle_table.h), else a pair's (both sides)
     double percent;
   };
   auto add = [&](bool expression, int number, int jaw, std::vector<Pair> pairs, const char *note,
@@ -179,7 +185,7 @@ std::vector<HighLevelMapping> make_high_level_table() {
     m.parts = std::move(parts);
     for (const Pair &p : pairs) {
       const std::string name = p.muscle;
-      if (name == "orbicularis_oris") m.muscles.push_back({name, p.percent});
+      if (find_muscle(name) >= 0) m.muscles.push_back({name, p.percent});
       else
         for (const char *side : {"_left", "_right"}) m.muscles.push_back({name + side, p.percent});
     }
@@ -196,20 +202,24 @@ std::vector<HighLevelMapping> make_high_level_table() {
   add(false, 3, 100, {}, "jaw a little open, tongue between the teeth", {{45, 150}, {44, 100}});
   add(false, 4, 90, {}, "jaw a little open, tongue tip up to the ridge", {{44, 400}, {45, 50}});
   add(false, 5, 130, {}, "jaw half open, tongue body up to the soft palate", {{46, 450}});
-  add(false, 6, 80, {{"orbicularis_oris", 60}, {"upper_lip", -20}}, "lips rounded and pushed out, tongue blade up",
-      {{44, 300}, {46, 200}});
+  // The rounded visemes push the lips out too (docs/anatomy.md, "Lip
+  // protrusion"): orbicularis oris alone rounds them in place.
+  add(false, 6, 80,
+      {{"orbicularis_oris", 60}, {"upper_lip", -20}, {"lip_protrusion_upper", 50}, {"lip_protrusion_lower", 50}},
+      "lips rounded and pushed out, tongue blade up", {{44, 300}, {46, 200}});
   add(false, 7, 50, {{"risorius", 50}}, "teeth near, lips spread, tongue tip up", {{44, 300}});
   add(false, 8, 100, {}, "jaw a little open, tongue tip up to the ridge", {{44, 400}});
-  add(false, 9, 90, {{"orbicularis_oris", 40}}, "lips a little rounded, tongue tip up and back",
-      {{44, 250}, {45, -100}});
+  add(false, 9, 90, {{"orbicularis_oris", 40}, {"lip_protrusion_upper", 25}, {"lip_protrusion_lower", 25}},
+      "lips a little rounded, tongue tip up and back", {{44, 250}, {45, -100}});
   add(false, 10, 300, {}, "jaw wide open, tongue low", {{46, -200}});
   add(false, 11, 180, {{"risorius", 50}, {"zygomaticus_major", 20}}, "jaw open, lips spread, tongue half high",
       {{46, 150}});
   add(false, 12, 100, {{"risorius", 70}, {"zygomaticus_major", 30}}, "lips spread wide, tongue high",
       {{46, 250}});
-  add(false, 13, 250, {{"orbicularis_oris", 40}}, "jaw open, lips rounded, tongue low", {{46, -150}});
-  add(false, 14, 90, {{"orbicularis_oris", 90}}, "lips tightly rounded and pushed out, tongue back up",
-      {{46, 200}});
+  add(false, 13, 250, {{"orbicularis_oris", 40}, {"lip_protrusion_upper", 40}, {"lip_protrusion_lower", 40}},
+      "jaw open, lips rounded, tongue low", {{46, -150}});
+  add(false, 14, 90, {{"orbicularis_oris", 90}, {"lip_protrusion_upper", 80}, {"lip_protrusion_lower", 80}},
+      "lips tightly rounded and pushed out, tongue back up", {{46, 200}});
   // ---- expressions (ISO/IEC 14496-2 Table C-3) ----
   // Fear widens the pupils (the sympathetic response; FAPs 29, 30, reference
   // 300 IRISD units), surprise a little.

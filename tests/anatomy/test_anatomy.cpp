@@ -177,12 +177,21 @@ int penetrating_nodes(const SkinModel &s, const Eigen::MatrixXd &X, double slack
 
 TEST(MuscleTable, TwentyFiveMusclesWithParsableKeyPoints) {
   const auto &t = muscle_table();
-  ASSERT_EQ(t.size(), 29u) << "the paper's 25 and four lid drivers";
+  ASSERT_EQ(t.size(), 31u) << "the paper's 25, four lid drivers and two lip protrusion drivers";
   int linear = 0, sphincter = 0;
   for (const MuscleDef &d : t) {
-    const bool paper = &d - t.data() < kPaperMuscles;
-    EXPECT_EQ(d.kind == MuscleKind::Lid, !paper) << d.name;
-    EXPECT_EQ(d.corner_outer != nullptr, !paper) << d.name;
+    const long row = &d - t.data();
+    const bool paper = row < kPaperMuscles, lid = row >= kPaperMuscles && row < kPaperMuscles + 4;
+    EXPECT_EQ(d.kind == MuscleKind::Lid, lid) << d.name;
+    EXPECT_EQ(d.corner_outer != nullptr, lid) << d.name;
+    if (!paper && !lid) {
+      // The lip protrusion drivers: linear muscles that push (like mentalis)
+      // from a key point behind the lip.
+      EXPECT_EQ(d.kind, MuscleKind::Linear) << d.name;
+      EXPECT_EQ(d.sense, -1) << d.name;
+      EXPECT_EQ(d.line, PullLine::Key) << d.name;
+      EXPECT_EQ(std::string(d.name).rfind("lip_protrusion_", 0), 0u) << d.name;
+    }
     if (paper) (d.kind == MuscleKind::Linear ? linear : sphincter)++;
     for (const char *text : {d.attachment_or_major, d.insertion_or_minor, d.epicentre, d.corner_outer, d.corner_inner}) {
       if (!text) continue;
@@ -384,7 +393,7 @@ TEST(Muscles, LoadHessianMatchesFiniteDifferences) {
 
 TEST(Muscles, AllPlacedSymmetricallyOnTheReferenceHead) {
   const FaceModel &m = head_1k().model;
-  EXPECT_EQ(m.muscles.size(), 29u);
+  EXPECT_EQ(m.muscles.size(), muscle_table().size());
   EXPECT_TRUE(m.warnings.empty());
   for (const Muscle &mu : m.muscles) {
     EXPECT_FALSE(mu.influence.empty()) << mu.name;
@@ -515,6 +524,22 @@ TEST(Physics, EachMuscleMovesItsRegionTheWayAnatomySays) {
     EXPECT_GT(moved(m, X, "8.4").x(), 0.2e-3) << "the right corner moves in";
     EXPECT_EQ(inverted_elements(m.tissue, X), 0);
   }
+  // The lip protrusion drivers push their lip's middle out of the face, more
+  // out than up or down, and leave the other lip (docs/anatomy.md, "Lip
+  // protrusion"). Orbicularis oris, which MPEG-4's push_b_lip and push_t_lip
+  // had before, moved 8.1 and 8.2 up and down more than out.
+  for (const auto &[name, own, other] : {std::array<const char *, 3>{"lip_protrusion_lower", "8.2", "8.1"},
+                                         std::array<const char *, 3>{"lip_protrusion_upper", "8.1", "8.2"}}) {
+    const Eigen::MatrixXd X = contract(m, name, t);
+    const Eigen::Vector3d d = moved(m, X, own), o = moved(m, X, other);
+    std::printf("%s: %s out %.3f mm, up %.3f mm; %s moves %.3f mm\n", name, own, mm(d.z()), mm(d.y()), other,
+                mm(o.norm()));
+    EXPECT_GT(d.z(), 0.1e-3) << name << " pushes its lip out";
+    EXPECT_LT(std::abs(d.y()), 0.5 * d.z()) << name << " pushes its lip out more than up or down";
+    EXPECT_LT(o.norm(), 0.5 * d.z()) << name << " leaves the other lip";
+    EXPECT_EQ(inverted_elements(m.tissue, X), 0) << name;
+    EXPECT_TRUE(X.allFinite()) << name;
+  }
   {
     const Eigen::MatrixXd X = contract(m, "orbicularis_oculi_left", t);
     const double before = m.fdps.find(*FdpId::parse("3.1"))->pos.y() - m.fdps.find(*FdpId::parse("3.3"))->pos.y();
@@ -583,7 +608,7 @@ TEST(Physics, WithTheCollapseFloorNoSlabTurnsAtTheFullRange) {
   std::unique_ptr<Built> floored = afmtest::build_reference_model(1000, fo);
   ASSERT_TRUE(floored);
   const FaceModel &m = floored->model;
-  ASSERT_EQ(m.muscles.size(), 29u);
+  ASSERT_EQ(m.muscles.size(), muscle_table().size());
   std::vector<Activation> poses;
   for (size_t i = 0; i < m.muscles.size(); ++i)
     for (double pct : {-100.0, 100.0}) {
@@ -1535,13 +1560,13 @@ TEST(BadInput, NotAFaceFlippedOrMissingFdps) {
     fo.estimate_missing_fdps = false;
     Expected<FaceModel> m = build_face_model(b.head.scene, f, fo);
     ASSERT_TRUE(m.is_ok()) << m.status().message();
-    EXPECT_EQ(m->muscles.size(), 23u);
+    EXPECT_EQ(m->muscles.size(), muscle_table().size() - 6) << "the six frontalis skipped";
     ASSERT_FALSE(m->warnings.empty());
     EXPECT_NE(m->warnings[0].find("11.1"), std::string::npos) << m->warnings[0];
     fo.estimate_missing_fdps = true;
     m = build_face_model(b.head.scene, f, fo);
     ASSERT_TRUE(m.is_ok());
-    EXPECT_EQ(m->muscles.size(), 29u);
+    EXPECT_EQ(m->muscles.size(), muscle_table().size());
     ASSERT_FALSE(m->notes.empty());
     EXPECT_NE(m->notes[0].find("FDP 11.1 absent"), std::string::npos);
   }
@@ -1643,7 +1668,7 @@ TEST(Builds, SongHeadPlacesItsMusclesAndJaw) {
   ASSERT_TRUE(f.is_ok()) << f.status().message();
   Expected<FaceModel> m = song_model(*f, "zygomaticus_major_left");
   ASSERT_TRUE(m.is_ok()) << m.status().message();
-  EXPECT_EQ(m->muscles.size(), 29u);
+  EXPECT_EQ(m->muscles.size(), muscle_table().size());
   EXPECT_GE(m->notes.size(), 10u) << "Song lacks the hairline, eye corners, jaw corners...";
   EXPECT_EQ(m->tissue.n, 2916);
   FactorCache cache;
@@ -1668,7 +1693,7 @@ TEST(Builds, ReferenceHeadAtTwoResolutions) {
     fo.calibrate_only = {"corrugator_left"};
     Expected<FaceModel> m = build_face_model(h->scene, h->fdps, fo);
     ASSERT_TRUE(m.is_ok()) << n << ": " << m.status().message();
-    EXPECT_EQ(m->muscles.size(), 29u);
+    EXPECT_EQ(m->muscles.size(), muscle_table().size());
     EXPECT_FALSE(m->jaw.dynamic.empty());
     EXPECT_GT(m->muscles[static_cast<size_t>(m->find("corrugator_left"))].tension_max, 0);
   }
