@@ -81,6 +81,12 @@ const std::vector<MuscleDef> kTable = {
     // moves the lip 15 % of the fibre out (about MW0 / 7).
     {"lip_protrusion_upper", K::Linear, "2.2 + 1/4 (2.13 - 2.3) + 1/4 (2.14 - 2.3)", "1/2 (2.2 + 8.1)", nullptr, 0.20, -1, 0.15, 0.05, false, true, false, L::Key, nullptr, nullptr, true},
     {"lip_protrusion_lower", K::Linear, "2.3 + 1/4 (2.13 - 2.3) + 1/4 (2.14 - 2.3)", "1/2 (2.3 + 8.2)", nullptr, 0.20, -1, 0.15, 0.05, false, true, false, L::Key, nullptr, nullptr, true},
+    // The nose's wings flared (not in the paper; docs/anatomy.md "Nostril
+    // dilators"): the alar part of nasalis, each wing (9.1, 9.2) pushed
+    // out from the point between them, its -100 % drawing it in. The
+    // paper's nasalis (9.7 -> 9.1) moves the wing back and up.
+    {"dilator_naris_left", K::Linear, "1/2 (9.1 + 9.2)", "9.1", nullptr, 0.30, -1, 0.20, 0.10, false, false, false, L::Key, nullptr, nullptr, true},
+    {"dilator_naris_right", K::Linear, "1/2 (9.1 + 9.2)", "9.2", nullptr, 0.30, -1, 0.20, 0.10, false, false, false, L::Key, nullptr, nullptr, true},
 };
 
 struct Parser {

@@ -1,7 +1,8 @@
 // The 25 muscles of the method paper (Tables 1 and 2), as data, and the
 // drivers this project adds: four for the lids (the palpebral part of
-// orbicularis oculi, one per lid: docs/anatomy.md "The lids") and two that
-// push the lips out (docs/anatomy.md "Lip protrusion").
+// orbicularis oculi, one per lid: docs/anatomy.md "The lids"), two that
+// push the lips out (docs/anatomy.md "Lip protrusion") and two that flare
+// the nose's wings (docs/anatomy.md "Nostril dilators").
 //
 // Key points are written as in the paper, affine combinations of FDP
 // positions: "11.1 + 1/6 (11.3 - 11.1)". parse_keypoint() turns one into
@@ -85,7 +86,7 @@ struct MuscleDef {
   // Linear: the load acts on each influence vertex's epidermal, dermal and
   // hypodermal nodes, a third each, instead of the dermal node alone: a
   // muscle inside the tissue it moves (the lip protrusion drivers: the lip's
-  // own orbicularis), not under it. Pushed by its dermis alone, the upper
+  // own orbicularis; the nostril dilators: the wing's), not under it. Pushed by its dermis alone, the upper
   // lip's dermis passed through its epidermis (docs/anatomy.md).
   bool whole_thickness = false;
 };
@@ -93,7 +94,8 @@ struct MuscleDef {
 // The 25 muscles, in the paper's order (Table 1 top to bottom, left before
 // right, then Table 2), then the four lid drivers (upper left, upper right,
 // lower left, lower right), then the two lip protrusion drivers (upper,
-// lower; linear muscles that push).
+// lower) and the two nostril dilators (left, right): linear muscles that
+// push.
 const std::vector<MuscleDef> &muscle_table();
 // "linear", "sphincter", "lid".
 const char *muscle_kind_name(MuscleKind kind);

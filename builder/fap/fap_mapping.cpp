@@ -115,8 +115,8 @@ std::vector<FapMapping> make_table() {
   // ---- group 7: head ----
   for (int f = 48; f <= 50; ++f) add(f, D::Rigid, 0, {}, {}, rigid_head);
   // ---- group 9: nose ----
-  add(61, D::Muscles, 100, {{"nasalis_left", -100}}, {{"nasalis_left", 100}}, "");
-  add(62, D::Muscles, 100, {{"nasalis_right", -100}}, {{"nasalis_right", 100}}, "");
+  add(61, D::Muscles, 100, {{"dilator_naris_left", 100}}, {{"dilator_naris_left", -100}}, "the nose's wing flared");
+  add(62, D::Muscles, 100, {{"dilator_naris_right", 100}}, {{"dilator_naris_right", -100}}, "the nose's wing flared");
   add(63, D::Muscles, 60, {{"nasalis_left", 100}, {"nasalis_right", 100}},
       {{"nasalis_left", -100}, {"nasalis_right", -100}}, "");
   add(64, D::Muscles, 60, {{"nasalis_left", 100}, {"nasalis_right", -100}},

@@ -177,7 +177,7 @@ int penetrating_nodes(const SkinModel &s, const Eigen::MatrixXd &X, double slack
 
 TEST(MuscleTable, TwentyFiveMusclesWithParsableKeyPoints) {
   const auto &t = muscle_table();
-  ASSERT_EQ(t.size(), 31u) << "the paper's 25, four lid drivers and two lip protrusion drivers";
+  ASSERT_EQ(t.size(), 33u) << "the paper's 25, four lid drivers, two lip protrusion drivers, two nostril dilators";
   int linear = 0, sphincter = 0;
   for (const MuscleDef &d : t) {
     const long row = &d - t.data();
@@ -185,12 +185,15 @@ TEST(MuscleTable, TwentyFiveMusclesWithParsableKeyPoints) {
     EXPECT_EQ(d.kind == MuscleKind::Lid, lid) << d.name;
     EXPECT_EQ(d.corner_outer != nullptr, lid) << d.name;
     if (!paper && !lid) {
-      // The lip protrusion drivers: linear muscles that push (like mentalis)
-      // from a key point behind the lip.
+      // The lip protrusion drivers and the nostril dilators: linear muscles
+      // that push (like mentalis) from a key point, on the tissue's whole
+      // thickness.
       EXPECT_EQ(d.kind, MuscleKind::Linear) << d.name;
       EXPECT_EQ(d.sense, -1) << d.name;
       EXPECT_EQ(d.line, PullLine::Key) << d.name;
-      EXPECT_EQ(std::string(d.name).rfind("lip_protrusion_", 0), 0u) << d.name;
+      EXPECT_TRUE(d.whole_thickness) << d.name;
+      const std::string n = d.name;
+      EXPECT_TRUE(n.rfind("lip_protrusion_", 0) == 0 || n.rfind("dilator_naris_", 0) == 0) << n;
     }
     if (paper) (d.kind == MuscleKind::Linear ? linear : sphincter)++;
     for (const char *text : {d.attachment_or_major, d.insertion_or_minor, d.epicentre, d.corner_outer, d.corner_inner}) {
@@ -539,6 +542,18 @@ TEST(Physics, EachMuscleMovesItsRegionTheWayAnatomySays) {
     EXPECT_LT(o.norm(), 0.5 * d.z()) << name << " leaves the other lip";
     EXPECT_EQ(inverted_elements(m.tissue, X), 0) << name;
     EXPECT_TRUE(X.allFinite()) << name;
+  }
+  {
+    // The left nostril dilator flares the left wing of the nose (9.1) out,
+    // more out than up, and leaves the right one (docs/anatomy.md).
+    const Eigen::MatrixXd X = contract(m, "dilator_naris_left", t);
+    const Eigen::Vector3d d = moved(m, X, "9.1"), o = moved(m, X, "9.2");
+    std::printf("dilator_naris_left: 9.1 out %.3f mm, up %.3f mm; 9.2 moves %.3f mm\n", mm(d.x()), mm(d.y()),
+                mm(o.norm()));
+    EXPECT_GT(d.x(), 0.1e-3) << "the left wing goes out (+x)";
+    EXPECT_LT(std::abs(d.y()), 0.5 * d.x()) << "out more than up or down";
+    EXPECT_LT(o.norm(), 0.2 * d.x()) << "the right wing stays";
+    EXPECT_EQ(inverted_elements(m.tissue, X), 0);
   }
   {
     const Eigen::MatrixXd X = contract(m, "orbicularis_oculi_left", t);

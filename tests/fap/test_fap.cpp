@@ -122,14 +122,14 @@ const Built &head_1k() {
   if (!b) {
     FaceModelOptions fo;
     // FAP 12's helpers (fap_mapping.cpp) too: zygomaticus minor, the upper
-    // lip, risorius and orbicularis oris; nasalis for FAP 61, whose helpers
-    // are the upper lip and zygomaticus minor; and the left lids' drivers:
+    // lip, risorius and orbicularis oris; FAP 41's (zygomatici) helper
+    // orbicularis oculi; nasalis for FAP 64; and the left lids' drivers:
     // the upper one calibrates to half its range (FAP 19 then turns the lid
     // as a whole), the lower one to all of it.
     fo.calibrate_only = {"zygomaticus_major_left", "depressor_anguli_left", "frontalis_major_left", "corrugator_left",
                          "mentalis_left", "mentalis_right", "zygomaticus_minor_left", "upper_lip_left",
-                         "risorius_left", "orbicularis_oris", "nasalis_left", "nasalis_right",
-                         "palpebral_upper_left", "palpebral_lower_left"};
+                         "risorius_left", "orbicularis_oris", "orbicularis_oculi_left", "nasalis_left",
+                         "nasalis_right", "palpebral_upper_left", "palpebral_lower_left"};
     b = afmtest::build_reference_model(1000, fo);
   }
   return *b;
@@ -457,17 +457,19 @@ TEST(FapSynthesis, HelpersSteerTheRaisedCornerBackOntoTheFapsDirection) {
 }
 
 // A group that falls short of its FAP is steered toward the whole
-// prescribed motion: on the 1k head nasalis alone widens the nostril (FAP
-// 61) to under half its prescription and moves it further than that off
-// the direction; with zygomaticus minor helping it gets further along and
-// nearer the direction. Measured from the targets at the FAP's FDP.
+// prescribed motion: on the 1k head the zygomatici alone lift the cheek
+// (FAP 41) to 70 % of its prescription, 38 % of it off the direction; with
+// orbicularis oculi helping, the cheek gets further along and nearer the
+// direction (75 %, 35 %). Measured from the targets at the FAP's FDP. (Until
+// the nose's wings had their dilators, nasalis fell short of FAP 61 and
+// showed it more: 43 -> 73 % along, 104 -> 70 % off.)
 TEST(FapSynthesis, HelpersTakeAnUnderReachingGroupFurtherAndNearerItsDirection) {
   const FaceModel &m = head_1k().model;
-  const afm_fap_info *info = afm_fap(61);
-  const Eigen::Vector3d dir = direction_of(61);
-  const double value = 100 * fapu_distance(m.fapu, info->unit) / 1024.0;
+  const afm_fap_info *info = afm_fap(41);
+  const Eigen::Vector3d dir = direction_of(41);
+  const double value = 120 * fapu_distance(m.fapu, info->unit) / 1024.0;  // its reference (fap_mapping.cpp)
   auto make = [&](bool steer) {
-    const Solo t = solo_target(61, steer);
+    const Solo t = solo_target(41, steer);
     std::pair<FapOutcome, Eigen::Vector3d> out;
     if (t.made) out = {t.outcome, at_fdp(t.target, info->fdp_group, info->fdp_index)};
     return out;
@@ -476,16 +478,16 @@ TEST(FapSynthesis, HelpersTakeAnUnderReachingGroupFurtherAndNearerItsDirection) 
   const auto [steered, d_steered] = make(true);
   ASSERT_FALSE(HasFailure());
   auto off_axis = [&dir](const Eigen::Vector3d &d) { return (d - d.dot(dir) * dir).norm(); };
-  EXPECT_LT(d_alone.dot(dir), 0.6 * value) << "the group alone reaches its prescription: " << alone.message;
-  EXPECT_GT(off_axis(d_alone), 0.5 * value);
-  EXPECT_GT(d_steered.dot(dir), d_alone.dot(dir) + 0.1 * value) << steered.message;
-  EXPECT_LT(off_axis(d_steered), 0.8 * off_axis(d_alone)) << steered.message;
+  EXPECT_LT(d_alone.dot(dir), 0.9 * value) << "the group alone reaches its prescription: " << alone.message;
+  EXPECT_GT(off_axis(d_alone), 0.2 * value);
+  EXPECT_GT(d_steered.dot(dir), d_alone.dot(dir) + 0.02 * value) << steered.message;
+  EXPECT_LT(off_axis(d_steered), off_axis(d_alone) - 0.01 * value) << steered.message;
   EXPECT_LT((d_steered - value * dir).norm(), (d_alone - value * dir).norm());
-  EXPECT_NE(steered.message.find("zygomaticus_minor_left"), std::string::npos) << steered.message;
+  EXPECT_NE(steered.message.find("orbicularis_oculi_left"), std::string::npos) << steered.message;
   EXPECT_NE(steered.message.find(", along "), std::string::npos) << "the message says how far it got: "
                                                                   << steered.message;
   EXPECT_NEAR(steered.reached, d_steered.dot(dir) / value, 1e-9);
-  std::printf("FAP 61 on the 1k head, alone: %.0f %% along, %.0f %% off; steered: %.0f %% along, %.0f %% off (%s)\n",
+  std::printf("FAP 41 on the 1k head, alone: %.0f %% along, %.0f %% off; steered: %.0f %% along, %.0f %% off (%s)\n",
               100 * d_alone.dot(dir) / value, 100 * off_axis(d_alone) / value, 100 * d_steered.dot(dir) / value,
               100 * off_axis(d_steered) / value, steered.message.c_str());
 }
