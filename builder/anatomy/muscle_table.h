@@ -86,8 +86,9 @@ struct MuscleDef {
   // Linear: the load acts on each influence vertex's epidermal, dermal and
   // hypodermal nodes, a third each, instead of the dermal node alone: a
   // muscle inside the tissue it moves (the lip protrusion drivers: the lip's
-  // own orbicularis; the nostril dilators: the wing's), not under it. Pushed by its dermis alone, the upper
-  // lip's dermis passed through its epidermis (docs/anatomy.md).
+  // own orbicularis; the nostril dilators: the wing's), not under it.
+  // Pushed by its dermis alone, the upper lip's dermis passed through its
+  // epidermis (docs/anatomy.md).
   bool whole_thickness = false;
 };
 
