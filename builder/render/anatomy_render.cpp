@@ -233,7 +233,10 @@ Status check_muscle(const FaceModel &model, const Muscle &m, const std::string &
 
 // A muscle's fibre or ellipse (white) and, with `key_dots`, its key nodes:
 // linear attachment green and insertion red, sphincter semi-axis nodes red;
-// a lid driver's line from its margin (red) to the other lid's.
+// a lid driver's line from its margin (red) to the other lid's. A muscle
+// inside the tissue it moves (MuscleDef::whole_thickness: the lips' and the
+// nose's drivers) shows its insertion only: its fibre starts at a point
+// inside the mouth or the nose, not on the skull.
 void muscle_overlay(const FaceModel &model, const Epidermis &skin, const Scale &scale,
                     const Muscle &m, bool key_dots, std::vector<SceneMarkers> &lines,
                     std::vector<SceneMarkers> &dots) {
@@ -242,7 +245,9 @@ void muscle_overlay(const FaceModel &model, const Epidermis &skin, const Scale &
   const Eigen::Vector3d a0 = skin.vertex(t.vertex_of(m.node_a));
   const Eigen::Vector3d b0 = skin.vertex(t.vertex_of(m.node_b));
   const double dot_bias = scale.bias + 2 * scale.step;  // key dots over the lines
-  if (m.kind != MuscleKind::Sphincter) {
+  if (m.whole_thickness) {
+    if (key_dots) add_outlined(dots, rows_of({b0}), kRed, kDotPixels, dot_bias, scale.step);
+  } else if (m.kind != MuscleKind::Sphincter) {
     add_outlined(lines, rows_of(skin.project_segment(a, b, a0, b0, scale.spacing)), kWhite,
                  kLinePixels, scale.bias, scale.step);
     if (key_dots && m.kind == MuscleKind::Lid) {
