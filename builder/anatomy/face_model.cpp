@@ -550,9 +550,7 @@ Expected<Pose> solve_pose(const FaceModel &model, const Activation &a, FactorCac
     join(set, from->dynamic);
     // Carried from its jaw motion to this one's: the jaw's vertices whole,
     // the followers by their shares.
-    std::vector<double> share(static_cast<size_t>(skin.n), 0.0);
-    for (int v : model.jaw.vertices) share[static_cast<size_t>(v)] = 1;
-    for (const auto &[v, w] : model.jaw.followers) share[static_cast<size_t>(v)] = w;
+    const std::vector<double> share = jaw_shares(model.jaw, skin.n);
     for (int v : from->dynamic) {
       const double w = share[static_cast<size_t>(v)];
       const Eigen::Affine3d carry = w == 0 ? Eigen::Affine3d::Identity()
@@ -646,11 +644,9 @@ SkinFaults skin_faults(const FaceModel &model, const Eigen::MatrixXd &E) {
   }
   out.stretched_share = total > 0 ? stretched / total : 0;
   // The jaw's bone moves under its vertices and, in part, its followers'.
-  std::vector<char> on_jaw(static_cast<size_t>(s.n), 0);
-  for (int v : model.jaw.vertices) on_jaw[static_cast<size_t>(v)] = 1;
-  for (const auto &f : model.jaw.followers) on_jaw[static_cast<size_t>(f.first)] = 1;
+  const std::vector<double> on_jaw = jaw_shares(model.jaw, s.n);
   for (int v = 0; v < s.n; ++v) {
-    if (on_jaw[static_cast<size_t>(v)] || !s.in_mesh[static_cast<size_t>(v)] || !skull_rejects(s, v)) continue;
+    if (on_jaw[static_cast<size_t>(v)] > 0 || !s.in_mesh[static_cast<size_t>(v)] || !skull_rejects(s, v)) continue;
     const Eigen::Vector3d skull = s.X0.row(s.node(kSkull, v));
     if ((E.row(v).transpose() - skull).dot(s.normal.row(v).transpose()) < -model.quantum) out.sunk_vertices.push_back(v);
   }

@@ -137,6 +137,13 @@ Expected<Jaw> build_jaw(const SkinModel &skin, const FdpSet &fdps, const Fapu &f
   return jaw;
 }
 
+std::vector<double> jaw_shares(const Jaw &jaw, int n) {
+  std::vector<double> out(static_cast<size_t>(n), 0.0);
+  for (int v : jaw.vertices) out[static_cast<size_t>(v)] = 1;
+  for (const auto &[v, share] : jaw.followers) out[static_cast<size_t>(v)] = share;
+  return out;
+}
+
 Eigen::Affine3d jaw_share(const Jaw &jaw, const Eigen::Affine3d &motion, double share) {
   // motion = T(t) T(pivot) R T(-pivot): t = motion(pivot) - pivot, and R's
   // angle about the jaw's axis (signed: the axis is fixed).

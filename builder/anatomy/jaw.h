@@ -81,6 +81,10 @@ Expected<Jaw> build_jaw(const SkinModel &skin, const FdpSet &fdps, const Fapu &f
 // The rigid motion for opening, thrust and shift in percent (open >= 0).
 Eigen::Affine3d jaw_motion(const Jaw &jaw, double open_pct, double thrust_pct, double shift_pct);
 
+// Per skin vertex (n of them), the share of the jaw's motion it takes: 1 on
+// the jaw's vertices, a follower's share, else 0.
+std::vector<double> jaw_shares(const Jaw &jaw, int n);
+
 // How far the followers reach along the skin, in mouth widths (MW0).
 constexpr double kJawFollowBand = 1.0;
 

@@ -32,7 +32,8 @@ template <class Direction>
 double dead_load(const SkinModel &skin, const Muscle &m, double c, const Direction &direction,
                  const Eigen::MatrixXd &X, Eigen::MatrixXd *F) {
   double energy = 0;
-  const int first = m.whole_thickness ? kEpidermis : m.force_layer, last = m.whole_thickness ? kHypodermis : m.force_layer;
+  const bool whole = muscle_table()[static_cast<size_t>(m.def)].whole_thickness;
+  const int first = whole ? kEpidermis : m.force_layer, last = whole ? kHypodermis : m.force_layer;
   const double share = 1.0 / (last - first + 1);
   for (size_t i = 0; i < m.influence.size(); ++i)
     for (int layer = first; layer <= last; ++layer) {
@@ -253,7 +254,6 @@ Expected<Muscle> place_muscle(const SkinModel &skin, const FdpSet &fdps, int def
 
   if (d.kind == MuscleKind::Linear) {
     m.force_layer = kDermis;
-    m.whole_thickness = d.whole_thickness;
     m.node_a = key_node(skin, fdps, kSkull, keys[0], m.key_a);
     m.node_b = key_node(skin, fdps, kDermis, keys[1], m.key_b);
     // A muscle inside the tissue it moves (whole_thickness) has no skull

@@ -87,7 +87,6 @@ struct Muscle {
                                   // surface: equation 1's axes, and what pictures draw
   double width = 0;        // omega, or the sphincter's ellipse scale k
   int force_layer = kDermis;  // kDermis (linear) or kHypodermis (sphincter); lid: 0..2
-  bool whole_thickness = false;  // linear: on layers 0..2, a third each (MuscleDef)
   // Lid: the eyeball (index into SkinModel::eyes; its centre is `epicentre`)
   // and the axis (+x or -x) the lid turns about as it closes.
   int eye = -1;

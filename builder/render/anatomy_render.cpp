@@ -245,7 +245,7 @@ void muscle_overlay(const FaceModel &model, const Epidermis &skin, const Scale &
   const Eigen::Vector3d a0 = skin.vertex(t.vertex_of(m.node_a));
   const Eigen::Vector3d b0 = skin.vertex(t.vertex_of(m.node_b));
   const double dot_bias = scale.bias + 2 * scale.step;  // key dots over the lines
-  if (m.whole_thickness) {
+  if (muscle_table()[static_cast<size_t>(m.def)].whole_thickness) {
     if (key_dots) add_outlined(dots, rows_of({b0}), kRed, kDotPixels, dot_bias, scale.step);
   } else if (m.kind != MuscleKind::Sphincter) {
     add_outlined(lines, rows_of(skin.project_segment(a, b, a0, b0, scale.spacing)), kWhite,
