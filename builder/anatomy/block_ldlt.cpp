@@ -133,6 +133,10 @@ BlockLdlt::Result BlockLdlt::factorize(const SpMat &K) {
     d_inverse_[static_cast<size_t>(k)] = dk.inverse();
     if (!d_inverse_[static_cast<size_t>(k)].allFinite()) return Result::kSingular;
   }
+  lf_.resize(l_.size());
+  for (size_t q = 0; q < l_.size(); ++q) lf_[q] = l_[q].cast<float>();
+  df_.resize(d_inverse_.size());
+  for (size_t q = 0; q < d_inverse_.size(); ++q) df_[q] = d_inverse_[q].cast<float>();
   return definite ? Result::kDefinite : Result::kIndefinite;
 }
 
@@ -149,6 +153,21 @@ void BlockLdlt::solve(const Eigen::VectorXd &b, Eigen::VectorXd &x) const {
       z[i].noalias() -= l_[static_cast<size_t>(q)].transpose() * z[static_cast<size_t>(row_[static_cast<size_t>(q)])];
   x.resize(b.size());
   for (int i = 0; i < nodes_; ++i) x.segment<3>(3 * order_[static_cast<size_t>(i)]) = z[static_cast<size_t>(i)];
+}
+
+void BlockLdlt::precondition(const Eigen::VectorXd &b, Eigen::VectorXd &x) const {
+  std::vector<Eigen::Vector3f> &z = solve_work_f_;
+  z.resize(static_cast<size_t>(nodes_));
+  for (int i = 0; i < nodes_; ++i) z[static_cast<size_t>(i)] = b.segment<3>(3 * order_[static_cast<size_t>(i)]).cast<float>();
+  for (size_t i = 0; i < static_cast<size_t>(nodes_); ++i)
+    for (int q = col_start_[i]; q < col_start_[i + 1]; ++q)
+      z[static_cast<size_t>(row_[static_cast<size_t>(q)])].noalias() -= lf_[static_cast<size_t>(q)] * z[i];
+  for (size_t i = 0; i < static_cast<size_t>(nodes_); ++i) z[i] = df_[i] * z[i];
+  for (size_t i = static_cast<size_t>(nodes_); i-- > 0;)
+    for (int q = col_start_[i]; q < col_start_[i + 1]; ++q)
+      z[i].noalias() -= lf_[static_cast<size_t>(q)].transpose() * z[static_cast<size_t>(row_[static_cast<size_t>(q)])];
+  x.resize(b.size());
+  for (int i = 0; i < nodes_; ++i) x.segment<3>(3 * order_[static_cast<size_t>(i)]) = z[static_cast<size_t>(i)].cast<double>();
 }
 
 }  // namespace afmb

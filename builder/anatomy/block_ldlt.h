@@ -18,8 +18,8 @@
 // L(k, i) = (D_i^-1 Y_i)^T and D_k = K_kk - sum_i L(k, i) Y_i.
 //
 // Usage (solver.cpp): analyze() once per pattern, factorize() per matrix of
-// that pattern, solve() as often as needed. Not thread-safe (solve() too
-// uses work space); copyable.
+// that pattern, solve() or precondition() as often as needed. Not
+// thread-safe (the solves too use work space); copyable.
 #pragma once
 
 #include <Eigen/Core>
@@ -55,6 +55,10 @@ class BlockLdlt {
   // x = K^-1 b (n each). Only after a factorize() that was not kSingular.
   void solve(const Eigen::VectorXd &b, Eigen::VectorXd &x) const;
 
+  // x ~ K^-1 b in single precision (a float copy of the factors, made by
+  // factorize()): half the memory traffic of solve(), for preconditioning.
+  void precondition(const Eigen::VectorXd &b, Eigen::VectorXd &x) const;
+
   // The cost model of the solver's refresh rule, in scalar terms: the
   // multiply-adds of a factorisation (sum over L's scalar columns of their
   // squared lengths) and the nonzeros of the scalar unit lower triangle.
@@ -79,6 +83,8 @@ class BlockLdlt {
   std::vector<M3, Eigen::aligned_allocator<M3>> y_;
   std::vector<int> flag_, reach_, stack_, filled_;
   mutable std::vector<Eigen::Vector3d> solve_work_;
+  std::vector<Eigen::Matrix3f> lf_, df_;  // l_ and d_inverse_ in single precision
+  mutable std::vector<Eigen::Vector3f> solve_work_f_;
   double factor_flops_ = 0, nonzeros_ = 0;
 };
 

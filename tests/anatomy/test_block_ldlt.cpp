@@ -93,6 +93,11 @@ TEST(BlockLdlt, SolvesAPositiveDefiniteSystemAsADenseCholeskyDoes) {
   const Eigen::MatrixXd dense = Eigen::MatrixXd(K);
   const Eigen::VectorXd ref = dense.llt().solve(b);
   EXPECT_LT((x - ref).norm(), 1e-10 * ref.norm());
+  // The single-precision copy the solver preconditions with: the same
+  // solution to float accuracy.
+  Eigen::VectorXd xf;
+  f.precondition(b, xf);
+  EXPECT_LT((xf - ref).norm(), 1e-5 * ref.norm());
   // The ordering keeps the fill near a scalar AMD ordering's (Eigen's
   // simplicial factorisation of the same matrix); a second factorisation
   // of the same pattern gives the same solution.
