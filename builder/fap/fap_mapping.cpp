@@ -127,22 +127,23 @@ std::vector<FapMapping> make_table() {
   std::sort(t.begin(), t.end(), [](const FapMapping &a, const FapMapping &b) { return a.fap < b.fap; });
   // Helpers (fap_mapping.h): the muscles beside the group's that move its
   // FDP, on the FAP's own side, and orbicularis oris, which spans both (its
-  // cost, steer.h, counts the whole face it moves). Left out: the lids
-  // (they follow the eyeball, and so does their off-axis motion), pushing
-  // the lips and the chin (nothing behind the lips to push against),
-  // bending the nose.
+  // cost, steer.h, counts the whole face it moves); for the lips' vertical
+  // FAPs, the lip's protrusion driver, the one muscle that moves a lip in
+  // depth (a raised or lowered lip's middle comes forward or goes back).
+  // Left out: the lids (they follow the eyeball, and so does their off-axis
+  // motion), the chin, bending the nose.
   auto help = [&t](int fap, std::vector<std::string> names) {
     t[static_cast<size_t>(fap - 3)].helpers = std::move(names);
   };
   for (int o : {0, 47}) {
-    help(4 + o, {"orbicularis_oris"});
-    help(5 + o, {"orbicularis_oris", "depressor_anguli_left", "depressor_anguli_right"});
+    help(4 + o, {"orbicularis_oris", "lip_protrusion_upper"});
+    help(5 + o, {"orbicularis_oris", "depressor_anguli_left", "depressor_anguli_right", "lip_protrusion_lower"});
     for (const char *s : {"left", "right"}) {
       const std::string side = s;
       const int k = side == "left" ? 0 : 1;
       help(6 + k + o, {"zygomaticus_major_" + side, "depressor_anguli_" + side});
-      help(8 + k + o, {"zygomaticus_minor_" + side, "orbicularis_oris"});
-      help(10 + k + o, {"depressor_anguli_" + side, "orbicularis_oris"});
+      help(8 + k + o, {"zygomaticus_minor_" + side, "orbicularis_oris", "lip_protrusion_upper"});
+      help(10 + k + o, {"depressor_anguli_" + side, "orbicularis_oris", "lip_protrusion_lower"});
       help(12 + k + o, {"zygomaticus_minor_" + side, "upper_lip_" + side, "risorius_" + side, "orbicularis_oris"});
     }
   }
