@@ -140,34 +140,36 @@ BlockLdlt::Result BlockLdlt::factorize(const SpMat &K) {
   return definite ? Result::kDefinite : Result::kIndefinite;
 }
 
-void BlockLdlt::solve(const Eigen::VectorXd &b, Eigen::VectorXd &x) const {
-  std::vector<Eigen::Vector3d> &z = solve_work_;
-  z.resize(static_cast<size_t>(nodes_));
-  for (int i = 0; i < nodes_; ++i) z[static_cast<size_t>(i)] = b.segment<3>(3 * order_[static_cast<size_t>(i)]);
-  for (size_t i = 0; i < static_cast<size_t>(nodes_); ++i)
-    for (int q = col_start_[i]; q < col_start_[i + 1]; ++q)
-      z[static_cast<size_t>(row_[static_cast<size_t>(q)])].noalias() -= l_[static_cast<size_t>(q)] * z[i];
-  for (size_t i = 0; i < static_cast<size_t>(nodes_); ++i) z[i] = d_inverse_[i] * z[i];
-  for (size_t i = static_cast<size_t>(nodes_); i-- > 0;)
-    for (int q = col_start_[i]; q < col_start_[i + 1]; ++q)
-      z[i].noalias() -= l_[static_cast<size_t>(q)].transpose() * z[static_cast<size_t>(row_[static_cast<size_t>(q)])];
+namespace {
+
+// x = P^T L^-T D^-1 L^-1 P b with the factors' blocks `l` (per L block) and
+// `d` (D's inverse per node), in their scalar type; z is work space.
+template <class Blocks, class Vectors>
+void substitute(const std::vector<int> &order, const std::vector<int> &col_start, const std::vector<int> &row,
+                const Blocks &l, const Blocks &d, Vectors &z, const Eigen::VectorXd &b, Eigen::VectorXd &x) {
+  using Scalar = typename Vectors::value_type::Scalar;
+  const size_t n = order.size();
+  z.resize(n);
+  for (size_t i = 0; i < n; ++i) z[i] = b.segment<3>(3 * order[i]).template cast<Scalar>();
+  for (size_t i = 0; i < n; ++i)
+    for (int q = col_start[i]; q < col_start[i + 1]; ++q)
+      z[static_cast<size_t>(row[static_cast<size_t>(q)])].noalias() -= l[static_cast<size_t>(q)] * z[i];
+  for (size_t i = 0; i < n; ++i) z[i] = d[i] * z[i];
+  for (size_t i = n; i-- > 0;)
+    for (int q = col_start[i]; q < col_start[i + 1]; ++q)
+      z[i].noalias() -= l[static_cast<size_t>(q)].transpose() * z[static_cast<size_t>(row[static_cast<size_t>(q)])];
   x.resize(b.size());
-  for (int i = 0; i < nodes_; ++i) x.segment<3>(3 * order_[static_cast<size_t>(i)]) = z[static_cast<size_t>(i)];
+  for (size_t i = 0; i < n; ++i) x.segment<3>(3 * order[i]) = z[i].template cast<double>();
+}
+
+}  // namespace
+
+void BlockLdlt::solve(const Eigen::VectorXd &b, Eigen::VectorXd &x) const {
+  substitute(order_, col_start_, row_, l_, d_inverse_, solve_work_, b, x);
 }
 
 void BlockLdlt::precondition(const Eigen::VectorXd &b, Eigen::VectorXd &x) const {
-  std::vector<Eigen::Vector3f> &z = solve_work_f_;
-  z.resize(static_cast<size_t>(nodes_));
-  for (int i = 0; i < nodes_; ++i) z[static_cast<size_t>(i)] = b.segment<3>(3 * order_[static_cast<size_t>(i)]).cast<float>();
-  for (size_t i = 0; i < static_cast<size_t>(nodes_); ++i)
-    for (int q = col_start_[i]; q < col_start_[i + 1]; ++q)
-      z[static_cast<size_t>(row_[static_cast<size_t>(q)])].noalias() -= lf_[static_cast<size_t>(q)] * z[i];
-  for (size_t i = 0; i < static_cast<size_t>(nodes_); ++i) z[i] = df_[i] * z[i];
-  for (size_t i = static_cast<size_t>(nodes_); i-- > 0;)
-    for (int q = col_start_[i]; q < col_start_[i + 1]; ++q)
-      z[i].noalias() -= lf_[static_cast<size_t>(q)].transpose() * z[static_cast<size_t>(row_[static_cast<size_t>(q)])];
-  x.resize(b.size());
-  for (int i = 0; i < nodes_; ++i) x.segment<3>(3 * order_[static_cast<size_t>(i)]) = z[static_cast<size_t>(i)].cast<double>();
+  substitute(order_, col_start_, row_, lf_, df_, solve_work_f_, b, x);
 }
 
 }  // namespace afmb

@@ -513,6 +513,34 @@ Status place_turned_lid(const FaceModel &model, const LidTurn &lid, Eigen::Matri
   return Status::ok();
 }
 
+namespace {
+
+// The skin a jaw motion starts its solve on. An opening short of the full
+// one: where the full opening's calibrated response, scaled to this one,
+// moves a node more than half the wave threshold (the muscles' first guess,
+// wave_estimate), with the jaw's vertices and followers, and a ring; the
+// solve grows it where the wave reaches further. Song's full opening moves
+// the whole skin, a viseme's third of it much less. Thrust, shift and the
+// full opening: the full opening's set.
+std::vector<int> jaw_set(const FaceModel &model, const Activation &a) {
+  const Jaw &jaw = model.jaw;
+  if (jaw.dynamic.empty()) return jaw.vertices;
+  const double share = a.jaw_open / 100;
+  if (a.jaw_thrust != 0 || a.jaw_shift != 0 || !(share < 1) || jaw.open_response.nodes.empty()) return jaw.dynamic;
+  const SkinModel &skin = model.tissue;
+  std::vector<int> out = jaw.vertices;
+  for (const auto &[v, w] : jaw.followers) out.push_back(v);
+  const NodeDisplacement &r = jaw.open_response;
+  for (size_t k = 0; k < r.nodes.size(); ++k)
+    if (share * r.displacement.row(static_cast<Eigen::Index>(k)).norm() > model.wave_threshold / 2)
+      out.push_back(skin.vertex_of(r.nodes[k]));
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return with_rings(skin, out, 1);
+}
+
+}  // namespace
+
 Expected<Pose> solve_pose(const FaceModel &model, const Activation &a, FactorCache *cache,
                           const PoseOptions &options) {
   const SkinModel &skin = model.tissue;
@@ -525,7 +553,7 @@ Expected<Pose> solve_pose(const FaceModel &model, const Activation &a, FactorCac
     if (a.jaw_open < 0) return Status::error("pose: the jaw does not open by a negative amount");
     pose.jaw = jaw_motion(model.jaw, a.jaw_open, a.jaw_thrust, a.jaw_shift);
     pose.X = carried_rest(model, pose.jaw);
-    join(set, model.jaw.dynamic.empty() ? model.jaw.vertices : model.jaw.dynamic);
+    join(set, jaw_set(model, a));
   }
   const Eigen::MatrixXd reference = pose.X;  // the rest state, carried by the jaw
   // Turned lids: the whole area turned by its shares is the first guess (a
@@ -592,7 +620,7 @@ Pose superposed_pose(const FaceModel &model, const Activation &a) {
   const bool jaw_moves = a.jaw_open != 0 || a.jaw_thrust != 0 || a.jaw_shift != 0;
   if (jaw_moves) out.jaw = jaw_motion(model.jaw, a.jaw_open, a.jaw_thrust, a.jaw_shift);
   out.X = jaw_moves ? carried_rest(model, out.jaw) : model.tissue.X0;
-  if (jaw_moves) add(model.jaw.open_response, std::max(a.jaw_open, 0.0) / 100, model.jaw.dynamic);
+  if (jaw_moves) add(model.jaw.open_response, std::max(a.jaw_open, 0.0) / 100, jaw_set(model, a));
   for (const auto &[i, pct] : a.muscles) {
     if (i < 0 || i >= static_cast<int>(model.muscles.size()) || pct == 0) continue;
     const Muscle &m = model.muscles[static_cast<size_t>(i)];

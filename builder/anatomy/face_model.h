@@ -25,7 +25,9 @@
 // moves more than the wave threshold (by default kWaveQuanta AFM quanta):
 // the elastic wave has died out. A pose solves on the union
 // of its muscles' (and the jaw's) sets and grows it again if the combination
-// reaches further.
+// reaches further. The jaw's set is its full opening's; a partial opening
+// starts where that opening's calibrated response, scaled to it, exceeds
+// half the wave threshold.
 #pragma once
 
 #include <Eigen/Core>

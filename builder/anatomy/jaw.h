@@ -68,7 +68,7 @@ struct Jaw {
   // "Followers" above): (vertex, share), 0 < share < 1, sorted by vertex,
   // none of them in `vertices`.
   std::vector<std::pair<int, double>> followers;
-  std::vector<int> dynamic;         // V_d of a full opening, sorted
+  std::vector<int> dynamic;         // V_d of a full opening, sorted (a partial one starts on less: face_model.h)
   // The calibrated pose of a full opening, from the rest carried by the
   // jaw (face_model.h: a first guess for poses that open it).
   NodeDisplacement open_response;

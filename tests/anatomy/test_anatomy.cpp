@@ -1265,6 +1265,36 @@ TEST(Physics, DynamicSetEqualsWholeMeshWithinOneQuantum) {
   EXPECT_FALSE(solve_pose(*m, other, &cache).is_ok());
 }
 
+// A partial opening starts on the skin the full one's calibrated response,
+// scaled to it, moves past half the wave threshold (face_model.h): a
+// viseme's third of an opening solves on less than the full opening's set,
+// and gets the whole mesh's pose within a quantum.
+TEST(Physics, APartialJawOpeningSolvesOnLessSkinWithinOneQuantum) {
+  FaceModelOptions fo;
+  fo.calibrate_only = {"risorius_left"};
+  Expected<FaceModel> m = build_face_model(head_1k().head.scene, head_1k().head.fdps, fo);
+  ASSERT_TRUE(m.is_ok()) << m.status().message();
+  ASSERT_FALSE(m->jaw.dynamic.empty());
+  Activation a;
+  a.jaw_open = 30;
+  FactorCache cache;
+  Expected<Pose> dyn = solve_pose(*m, a, &cache);
+  PoseOptions whole;
+  whole.whole_mesh = true;
+  Expected<Pose> all = solve_pose(*m, a, &cache, whole);
+  ASSERT_TRUE(dyn.is_ok() && all.is_ok());
+  EXPECT_LT(dyn->dynamic.size(), m->jaw.dynamic.size());
+  EXPECT_TRUE(std::includes(dyn->dynamic.begin(), dyn->dynamic.end(), m->jaw.vertices.begin(), m->jaw.vertices.end()));
+  const double diff = (pose_epidermis(*m, *dyn) - pose_epidermis(*m, *all)).cwiseAbs().maxCoeff();
+  EXPECT_LE(diff, m->quantum);
+  // The guess the synthesis starts from starts on the same smaller set.
+  const Pose guess = superposed_pose(*m, a);
+  EXPECT_LT(guess.dynamic.size(), m->jaw.dynamic.size());
+  EXPECT_TRUE(std::includes(dyn->dynamic.begin(), dyn->dynamic.end(), guess.dynamic.begin(), guess.dynamic.end()));
+  std::printf("jaw 30 %%: %zu of the full opening's %zu vertices, %.2f quanta from the whole mesh's pose\n",
+              dyn->dynamic.size(), m->jaw.dynamic.size(), diff / m->quantum);
+}
+
 TEST(Calibration, FullContractionMovesTheKeyNodeByItsTarget) {
   Expected<FaceModel> m = model_1k({"zygomaticus_major_left", "orbicularis_oris"});
   ASSERT_TRUE(m.is_ok()) << m.status().message();
