@@ -123,13 +123,15 @@ const Built &head_1k() {
     FaceModelOptions fo;
     // FAP 12's helpers (fap_mapping.cpp) too: zygomaticus minor, the upper
     // lip, risorius and orbicularis oris; FAP 41's (zygomatici) helper
-    // orbicularis oculi; nasalis for FAP 64; and the left lids' drivers:
-    // the upper one calibrates to half its range (FAP 19 then turns the lid
-    // as a whole), the lower one to all of it.
+    // orbicularis oculi; nasalis for FAP 64; the left lids' drivers: the
+    // upper one calibrates to half its range (FAP 19 then turns the lid as
+    // a whole), the lower one to all of it; FAP 4's group (both upper lips)
+    // and its helper, the upper lip's protrusion driver.
     fo.calibrate_only = {"zygomaticus_major_left", "depressor_anguli_left", "frontalis_major_left", "corrugator_left",
                          "mentalis_left", "mentalis_right", "zygomaticus_minor_left", "upper_lip_left",
                          "risorius_left", "orbicularis_oris", "orbicularis_oculi_left", "nasalis_left",
-                         "nasalis_right", "palpebral_upper_left", "palpebral_lower_left"};
+                         "nasalis_right", "palpebral_upper_left", "palpebral_lower_left", "upper_lip_right",
+                         "lip_protrusion_upper"};
     b = afmtest::build_reference_model(1000, fo);
   }
   return *b;
@@ -454,6 +456,27 @@ TEST(FapSynthesis, HelpersSteerTheRaisedCornerBackOntoTheFapsDirection) {
   EXPECT_NE(steered.outcome.message.find("steered by"), std::string::npos) << steered.outcome.message;
   std::printf("FAP 12 on the 1k head, off-axis share alone %.2f, steered %.2f (%s)\n", off_axis(alone.at_corner) / value,
               off_axis(steered.at_corner) / value, steered.outcome.message.c_str());
+}
+
+// Lowered by both upper lips, the 1k head's upper lip comes forward by
+// nearly a fifth of its drop (FAP 4: the lips' muscles act along lines that leave the
+// face's plane); its protrusion driver, a helper (fap_mapping.cpp), holds
+// it back, and the lip still drops by FAP 4's prescription. Measured from
+// the targets at 2.2.
+TEST(FapSynthesis, TheLipsDriverHoldsALoweredLipInTheFacesPlane) {
+  const FaceModel &m = head_1k().model;
+  const Eigen::Vector3d dir = direction_of(4);
+  const double value = 100 * fapu_distance(m.fapu, afm_fap(4)->unit) / 1024.0;
+  const Solo alone = solo_target(4, false), steered = solo_target(4, true);
+  ASSERT_TRUE(alone.made && steered.made);
+  const Eigen::Vector3d a = at_fdp(alone.target, 2, 2), s = at_fdp(steered.target, 2, 2);
+  for (const Eigen::Vector3d &d : {a, s}) EXPECT_NEAR(d.dot(dir), value, 4 * m.solver.tolerance);
+  EXPECT_GT(std::abs(a.z()), 0.1 * value) << "alone, the lip leaves the face's plane";
+  EXPECT_LT(std::abs(s.z()), 0.05 * value);
+  EXPECT_LT((s - s.dot(dir) * dir).norm(), 0.05 * value);
+  EXPECT_NE(steered.outcome.message.find("lip_protrusion_upper"), std::string::npos) << steered.outcome.message;
+  std::printf("FAP 4 on the 1k head: depth %.2f of the drop alone, %.2f steered (%s)\n", a.z() / value, s.z() / value,
+              steered.outcome.message.c_str());
 }
 
 // A group that falls short of its FAP is steered toward the whole
