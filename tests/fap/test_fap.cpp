@@ -459,10 +459,10 @@ TEST(FapSynthesis, HelpersSteerTheRaisedCornerBackOntoTheFapsDirection) {
 }
 
 // Lowered by both upper lips, the 1k head's upper lip comes forward by
-// nearly a fifth of its drop (FAP 4: the lips' muscles act along lines that leave the
-// face's plane); its protrusion driver, a helper (fap_mapping.cpp), holds
-// it back, and the lip still drops by FAP 4's prescription. Measured from
-// the targets at 2.2.
+// nearly a fifth of its drop (FAP 4: the lips' muscles act along lines that
+// leave the face's plane); its protrusion driver, a helper
+// (fap_mapping.cpp), holds it back, and the lip still drops by FAP 4's
+// prescription. Measured from the targets at 2.2.
 TEST(FapSynthesis, TheLipsDriverHoldsALoweredLipInTheFacesPlane) {
   const FaceModel &m = head_1k().model;
   const Eigen::Vector3d dir = direction_of(4);
