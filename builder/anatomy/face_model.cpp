@@ -125,11 +125,14 @@ ForceField unit_load(const FaceModel &model, const Muscle &m, double sign) {
 
 // The first guess at V_d: where the muscle's elastic wave is above half the
 // threshold at the larger of its two calibrated actions, by the rest state's
-// linear response (cheap: one factorisation per round), on the influence
-// area grown by rings until the response dies out at the set's border; plus
-// one ring. The calibration solves grow it where the nonlinear wave reaches
-// further.
-Expected<std::vector<int>> wave_estimate(const FaceModel &model, const Muscle &m) {
+// linear response; plus one ring. The calibration solves grow it where the
+// nonlinear wave reaches further. With `whole` (a cache holding the whole
+// skin's rest factorisation, shared by every muscle), the response is the
+// whole skin's: one triangular solve per muscle. Without it, on the
+// influence area grown by rings until the response dies out at the set's
+// border: one factorisation per round (Song: 113 rounds, 1.06 s of CPU,
+// against 0.07 s on the whole skin).
+Expected<std::vector<int>> wave_estimate(const FaceModel &model, const Muscle &m, FactorCache *whole) {
   const SkinModel &skin = model.tissue;
   Eigen::MatrixXd grad = Eigen::MatrixXd::Zero(skin.X0.rows(), 3);
   muscle_action(skin, m, skin.X0, &grad);
@@ -139,15 +142,15 @@ Expected<std::vector<int>> wave_estimate(const FaceModel &model, const Muscle &m
     if (grad.row(g).squaredNorm() > 0) seed.push_back(skin.vertex_of(static_cast<int>(g)));
   std::sort(seed.begin(), seed.end());
   seed.erase(std::unique(seed.begin(), seed.end()), seed.end());
-  std::vector<int> set = with_rings(skin, seed, 2);
+  std::vector<int> set = whole ? with_rings(skin, seed, skin.n) : with_rings(skin, seed, 2);
   for (int round = 0;; ++round) {
-    Expected<Eigen::MatrixXd> w = linear_response(skin, set, unit_load(model, m, 1.0), nullptr);
+    Expected<Eigen::MatrixXd> w = linear_response(skin, set, unit_load(model, m, 1.0), whole);
     if (!w) return w.status();
     const double a1 = (grad.array() * w->array()).sum();
     if (!(std::abs(a1) > 0)) return Status::error(m.name + ": the muscle does not move its key node");
     const Eigen::MatrixXd scaled = *w * (reach / std::abs(a1));
     const size_t before = set.size();
-    if (border_motion(skin, set, skin.X0 + scaled) > model.wave_threshold / 2) {
+    if (!whole && border_motion(skin, set, skin.X0 + scaled) > model.wave_threshold / 2) {
       set = with_rings(skin, set, 2 << std::min(round, 4));
       if (set.size() > before) continue;
     }
@@ -329,8 +332,16 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
   // takes a third of the model's CPU, and taken in table order it came last
   // and left the other worker idle.
   std::vector<Expected<std::vector<int>>> sets(todo.size(), Status::error("not estimated"));
-  for_each_task(todo.size(), options.threads,
-                [&](size_t k) { sets[k] = wave_estimate(model, model.muscles[todo[k]]); });
+  // One rest factorisation of the connected skin serves every muscle's
+  // estimate; where it is singular (a skin piece that nothing holds), each
+  // muscle grows its own set instead.
+  {
+    FactorCache whole;
+    for (size_t k = 0; k < todo.size(); ++k) sets[k] = wave_estimate(model, model.muscles[todo[k]], &whole);
+  }
+  for_each_task(todo.size(), options.threads, [&](size_t k) {
+    if (!sets[k]) sets[k] = wave_estimate(model, model.muscles[todo[k]], nullptr);
+  });
   auto weight = [&](size_t k) {
     return k < todo.size() ? (sets[k] ? sets[k]->size() : 0) : model.jaw.vertices.size();
   };

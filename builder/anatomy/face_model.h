@@ -19,8 +19,8 @@
 // Dynamic node sets (section 3.2.4): every solve runs on a set of skin
 // vertices; the rest stay exactly where they are. A muscle's set V_d starts
 // from the rest state's linear response (where the wave at the larger
-// calibrated action exceeds half the wave threshold, found on the influence
-// area grown by rings until the response dies out at its border), and both
+// calibrated action exceeds half the wave threshold; the whole connected
+// skin's response, from one rest factorisation shared by all muscles), and both
 // calibration solves grow it by rings until no vertex on the set's border
 // moves more than the wave threshold (by default kWaveQuanta AFM quanta):
 // the elastic wave has died out. A pose solves on the union
