@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <condition_variable>
 #include <mutex>
 
 #include "afm/afm_export.h"
@@ -17,6 +18,35 @@ int FaceModel::find(const std::string &muscle) const {
   for (size_t i = 0; i < muscles.size(); ++i)
     if (muscles[i].name == muscle) return static_cast<int>(i);
   return -1;
+}
+
+int FaceModel::twin(int muscle) const {
+  const std::string name = twin_name(muscles[static_cast<size_t>(muscle)].name);
+  return name.empty() ? -1 : find(name);
+}
+
+Eigen::MatrixXd mirrored_nodes(const FaceModel &model, const Eigen::MatrixXd &X) {
+  const SkinModel &skin = model.tissue;
+  Eigen::MatrixXd out = skin.X0;
+  for (int v = 0; v < skin.n; ++v) {
+    const int u = model.mirror.image[static_cast<size_t>(v)];
+    if (u < 0) continue;
+    for (int l = 0; l < kTissueLayers; ++l) {
+      Eigen::RowVector3d d = X.row(skin.node(l, u)) - skin.X0.row(skin.node(l, u));
+      d.x() = -d.x();
+      out.row(skin.node(l, v)) += d;
+    }
+  }
+  return out;
+}
+
+std::vector<int> mirrored_vertices(const FaceModel &model, const std::vector<int> &set) {
+  std::vector<int> out;
+  for (int v : set)
+    if (const int u = model.mirror.image[static_cast<size_t>(v)]; u >= 0) out.push_back(u);
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
 }
 
 double muscle_tension(const Muscle &m, double percent) {
@@ -207,8 +237,11 @@ Eigen::MatrixXd carried_rest(const FaceModel &model, const Eigen::Affine3d &jaw)
 // *locked: it failed because the tissue locked before the key node got there.
 // *torn (when given): the pose that gets there tears the skin
 // (SkinFaults::tears); the tension is set all the same.
+// With `twin` (the muscle's calibrated twin on a mirror-symmetric skin, at
+// the same range), the solve starts from the twin's pose mirrored, at its
+// tension, on the set joined with the twin's V_d mirrored.
 Status calibrate_side(const FaceModel &model, Muscle &m, bool maximum, FactorCache *cache, std::vector<int> &set,
-                      bool *locked, bool *torn) {
+                      bool *locked, bool *torn, const Muscle *twin = nullptr) {
   LoadControl control;
   control.unit_load = unit_load(model, m, maximum ? 1.0 : -1.0);
   control.action = [&](const Eigen::MatrixXd &X, Eigen::MatrixXd *g) { return muscle_action(model.tissue, m, X, g); };
@@ -216,6 +249,14 @@ Status calibrate_side(const FaceModel &model, Muscle &m, bool maximum, FactorCac
   SolverOptions opts = model.solver;
   if (opts.kind == SolverKind::ImplicitEuler) opts.kind = SolverKind::Newton;  // it cannot solve for a tension
   Eigen::MatrixXd X = model.tissue.X0;
+  if (twin && (maximum ? twin->range_max == m.range_max : twin->range_min == m.range_min)) {
+    const NodeDisplacement &r = maximum ? twin->response_max : twin->response_min;
+    Eigen::MatrixXd Xt = model.tissue.X0;
+    for (size_t i = 0; i < r.nodes.size(); ++i) Xt.row(r.nodes[i]) += r.displacement.row(static_cast<Eigen::Index>(i));
+    X = mirrored_nodes(model, Xt);
+    control.tension = maximum ? twin->tension_max : twin->tension_min;
+    join(set, mirrored_vertices(model, twin->dynamic));
+  }
   Status s = solve_growing(model, set, nullptr, model.tissue.X0, X, opts, model.wave_threshold, cache, false,
                            nullptr, nullptr, &control);
   if (locked) *locked = !s && control.unreachable;
@@ -255,6 +296,13 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
   Expected<SkinModel> tissue = build_skin_model(scene, model.skin, options.tissue);
   if (!tissue) return tissue.status();
   model.tissue = std::move(*tissue);
+  {
+    const FdpPoint *l = model.fdps.find(FdpId{3, 5}), *r = model.fdps.find(FdpId{3, 6});
+    if (l && r)
+      model.mirror = skin_mirror(model.tissue.X0.topRows(model.tissue.n), model.tissue.in_mesh,
+                                 0.5 * (l->pos.x() + r->pos.x()), kMirrorTolerance * (l->pos - r->pos).norm(),
+                                 &model.tissue.neighbours);
+  }
   progress(1, steps_fixed, "skin tissue");
 
   const std::vector<MuscleDef> &table = muscle_table();
@@ -345,14 +393,37 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
   auto weight = [&](size_t k) {
     return k < todo.size() ? (sets[k] ? sets[k]->size() : 0) : model.jaw.vertices.size();
   };
+  // On a mirror-symmetric skin, a right muscle whose left twin is
+  // calibrated too starts from its poses mirrored (calibrate_side): a few
+  // Newton iterations instead of a solve from rest. The right ones come
+  // last, and one whose twin is still running waits for it (tasks are
+  // taken in order, so the twin is running or done).
+  std::vector<int> twin_task(tasks, -1);
+  if (model.mirror.symmetric())
+    for (size_t k = 0; k < todo.size(); ++k) {
+      const int t = model.twin(static_cast<int>(todo[k]));
+      const std::string &name = model.muscles[todo[k]].name;
+      if (t < 0 || name.size() < 6 || name.compare(name.size() - 6, 6, "_right") != 0) continue;
+      for (size_t j = 0; j < todo.size(); ++j)
+        if (todo[j] == static_cast<size_t>(t)) twin_task[k] = static_cast<int>(j);
+    }
   std::vector<size_t> order(tasks);
   for (size_t k = 0; k < tasks; ++k) order[k] = k;
-  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return weight(a) > weight(b); });
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    if ((twin_task[a] >= 0) != (twin_task[b] >= 0)) return twin_task[b] >= 0;
+    return weight(a) > weight(b);
+  });
+  std::vector<char> calibrated(tasks, 0);
+  std::condition_variable calibrated_one;
   std::mutex lock;
   int finished = 0;
   const int total = static_cast<int>(tasks);
   for_each_task(tasks, options.threads, [&](size_t j) {
     const size_t k = order[j];
+    if (twin_task[k] >= 0) {
+      std::unique_lock<std::mutex> g(lock);
+      calibrated_one.wait(g, [&] { return calibrated[static_cast<size_t>(twin_task[k])] != 0; });
+    }
     FactorCache cache;
     std::string what = "jaw";
     if (k < todo.size()) {
@@ -366,16 +437,18 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
       // a half, a quarter or an eighth of it instead (not an essential one:
       // its range is what the FAPs rely on).
       const bool essential = table[static_cast<size_t>(m.def)].essential;
+      const int t = twin_task[k];
+      const Muscle *twin = t >= 0 && result[static_cast<size_t>(t)] ? &model.muscles[todo[static_cast<size_t>(t)]] : nullptr;
       auto side = [&](bool maximum) {
         bool locked = false, torn = false;
         int &why = cut[todo[k]][maximum ? 1 : 0];
-        Status st = calibrate_side(model, m, maximum, &cache, *set, &locked, essential ? nullptr : &torn);
+        Status st = calibrate_side(model, m, maximum, &cache, *set, &locked, essential ? nullptr : &torn, twin);
         double &range = maximum ? m.range_max : m.range_min;
         while ((!st || torn) && range > 0.125 && !essential) {
           if (why != 1) why = torn ? 1 : locked ? 0 : 3;
           range /= 2;
           locked = torn = false;
-          st = calibrate_side(model, m, maximum, &cache, *set, &locked, &torn);
+          st = calibrate_side(model, m, maximum, &cache, *set, &locked, &torn, twin);
         }
         // Torn even at an eighth: kept there, so that the FAPs and
         // expressions have the muscle; their own checks bound its share.
@@ -392,6 +465,8 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
       jaw_pose = solve_pose(model, open, &cache);
     }
     std::lock_guard<std::mutex> g(lock);
+    calibrated[k] = 1;
+    calibrated_one.notify_all();
     progress(++finished, total, what);
   });
 

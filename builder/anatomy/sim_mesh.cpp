@@ -20,10 +20,10 @@
 #include <limits>
 #include <queue>
 #include <string>
-#include <unordered_map>
 #include <utility>
 
 #include "anatomy/fdp_completion.h"
+#include "anatomy/mirror.h"
 #include "anatomy/muscle_table.h"
 #include "anatomy/muscles.h"
 #include "anatomy/skin_model.h"
@@ -64,9 +64,6 @@ constexpr double kLidKeep = 0.1;
 constexpr double kMaxNormalTurnDegrees = 60;
 constexpr double kMaxDistance = 0.03;
 constexpr float kMaxAspectRatio = 5;
-// Two skin vertices are mirror images when one lies within this many eye
-// separations of the other's reflection in the face's mid-plane.
-constexpr double kMirrorTolerance = 1e-3;
 
 // Priority: the edge's squared length over the squared sizing at its
 // midpoint (shortest first). Not binary: it orders the collapses.
@@ -120,44 +117,6 @@ void keep_lids(MeshT &mesh, const Part &skin, const std::vector<EyeSphere> &eyes
   const std::vector<int8_t> lid = near_eyeballs(skin.V, used, eyes, kLidKeep);
   for (size_t v = 0; v < lid.size(); ++v)
     if (lid[v] >= 0) mesh.status(typename MeshT::VertexHandle(static_cast<int>(v))).set_locked(true);
-}
-
-// For every skin vertex, the skin vertex at its mirror image in the plane
-// x = mid (within `tolerance`, the nearest), or -1.
-std::vector<int> mirror_vertices(const Part &skin, double mid, double tolerance) {
-  const int n = static_cast<int>(skin.V.rows());
-  std::vector<int> out(static_cast<size_t>(n), -1);
-  if (!(tolerance > 0)) return out;
-  // A hash grid of cells `tolerance` wide: the image's cell and its 26
-  // neighbours hold every candidate.
-  auto cell = [tolerance](const Eigen::Vector3d &x) {
-    return Eigen::Vector3i(static_cast<int>(std::floor(x.x() / tolerance)), static_cast<int>(std::floor(x.y() / tolerance)),
-                           static_cast<int>(std::floor(x.z() / tolerance)));
-  };
-  auto key = [](const Eigen::Vector3i &c) {
-    return (static_cast<uint64_t>(static_cast<uint32_t>(c.x())) * 73856093u) ^
-           (static_cast<uint64_t>(static_cast<uint32_t>(c.y())) * 19349663u) ^
-           (static_cast<uint64_t>(static_cast<uint32_t>(c.z())) * 83492791u);
-  };
-  std::unordered_multimap<uint64_t, int> grid;
-  for (int v = 0; v < n; ++v) grid.emplace(key(cell(skin.V.row(v).transpose())), v);
-  for (int v = 0; v < n; ++v) {
-    Eigen::Vector3d image = skin.V.row(v).transpose();
-    image.x() = 2 * mid - image.x();
-    const Eigen::Vector3i c = cell(image);
-    double best = tolerance;
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dz = -1; dz <= 1; ++dz) {
-          const auto range = grid.equal_range(key(c + Eigen::Vector3i(dx, dy, dz)));
-          for (auto it = range.first; it != range.second; ++it) {
-            const double d = (skin.V.row(it->second).transpose() - image).norm();
-            if (d < best || (d == best && out[static_cast<size_t>(v)] > it->second))
-              best = d, out[static_cast<size_t>(v)] = it->second;
-          }
-        }
-  }
-  return out;
 }
 
 // OpenMesh's decimater (the same modules, priorities and legality) with
@@ -465,16 +424,9 @@ Expected<SimMesh> make_sim_mesh(const Scene &scene, const FdpSet &fdps, const Si
   double mid = 0;
   std::vector<int> mirror;
   if (has_l && has_r) {
-    mirror = mirror_vertices(skin, 0.5 * (eye_l.x() + eye_r.x()), kMirrorTolerance * es0);
-    std::vector<double> middles;
-    for (int v = 0; v < n; ++v)
-      if (const int m = mirror[static_cast<size_t>(v)]; m >= 0) middles.push_back(0.5 * (skin.V(v, 0) + skin.V(m, 0)));
-    if (middles.size() * 10 >= static_cast<size_t>(n) * 9) {
-      std::nth_element(middles.begin(), middles.begin() + static_cast<std::ptrdiff_t>(middles.size() / 2), middles.end());
-      mid = middles[middles.size() / 2];
-    } else {
-      mirror.clear();  // not a symmetric skin
-    }
+    SkinMirror sm = skin_mirror(skin.V, {}, 0.5 * (eye_l.x() + eye_r.x()), kMirrorTolerance * es0);
+    mid = sm.mid;
+    mirror = std::move(sm.image);
   }
   if (!mirror.empty()) {
     for (int v = 0; v < n; ++v)

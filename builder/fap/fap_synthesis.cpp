@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
 #include <mutex>
 #include <optional>
@@ -38,12 +39,12 @@ constexpr double kChordShare = 0.75;
 // Bisection steps on the share of a viseme's or expression's pose that
 // keeps the skin a face: to a sixteenth.
 constexpr int kShareSteps = 4;
-// The other side's muscle of a "..._left" or "..._right" one, else "".
-std::string other_side(const std::string &name) {
-  for (const auto &[from, to] : {std::pair<const char *, const char *>{"_left", "_right"}, {"_right", "_left"}}) {
-    const size_t n = std::char_traits<char>::length(from);
-    if (name.size() > n && name.compare(name.size() - n, n, from) == 0) return name.substr(0, name.size() - n) + to;
-  }
+// The left twin's name of a right FAP ("raise_r_cornerlip",
+// "lower_t_lip_rm"), else "".
+std::string left_fap_name(const std::string &name) {
+  for (const char *right : {"_r_", "_rm"})
+    if (const size_t at = name.find(right); at != std::string::npos)
+      return name.substr(0, at) + (right[2] == 'm' ? "_lm" : "_l_") + name.substr(at + 3);
   return std::string();
 }
 
@@ -98,7 +99,7 @@ std::vector<char> blame(const FaceModel &model, const Activation &a, const SkinF
   const std::vector<char> direct = out;
   for (size_t k = 0; k < a.muscles.size(); ++k) {
     if (!direct[k]) continue;
-    const std::string other = other_side(model.muscles[static_cast<size_t>(a.muscles[k].first)].name);
+    const std::string other = twin_name(model.muscles[static_cast<size_t>(a.muscles[k].first)].name);
     for (size_t j = 0; j < a.muscles.size(); ++j)
       if (model.muscles[static_cast<size_t>(a.muscles[j].first)].name == other) out[j] = 1;
   }
@@ -112,7 +113,7 @@ std::string muscle_list(const FaceModel &model, const Activation &a, const std::
   for (size_t k = 0; k < a.muscles.size(); ++k) {
     if (!reduced[k]) continue;
     std::string n = model.muscles[static_cast<size_t>(a.muscles[k].first)].name;
-    const std::string other = other_side(n);
+    const std::string other = twin_name(n);
     bool both = false;
     for (size_t j = 0; j < a.muscles.size() && !other.empty(); ++j)
       both |= reduced[j] && model.muscles[static_cast<size_t>(a.muscles[j].first)].name == other;
@@ -237,6 +238,15 @@ bool lists_nothing(const FapSynthesisOptions &options) {
   return options.only.empty() && options.only_visemes.empty() && options.only_expressions.empty();
 }
 
+// Whether FAP `fap` is not listed in `options` but is the left twin of a
+// listed one.
+bool twin_of_listed(const FapSynthesisOptions &options, int fap) {
+  if (listed(options.only, fap)) return false;
+  for (int f : options.only)
+    if (left_fap_name(afm_fap(f)->name) == afm_fap(fap)->name) return true;
+  return false;
+}
+
 }  // namespace
 
 CalibrationNeeds calibration_needs(const FapSynthesisOptions &options) {
@@ -250,7 +260,7 @@ CalibrationNeeds calibration_needs(const FapSynthesisOptions &options) {
         need.muscles.push_back(c.muscle);
   };
   for (const FapMapping &m : fap_mappings()) {
-    if (!listed(options.only, m.fap)) continue;
+    if (!listed(options.only, m.fap) && !(m.driver == FapDriver::Muscles && twin_of_listed(options, m.fap))) continue;
     need.jaw |= m.driver == FapDriver::JawOpen || m.driver == FapDriver::JawThrust || m.driver == FapDriver::JawShift;
     if (m.driver != FapDriver::Muscles) continue;
     for (const auto *g : {&m.positive, &m.negative, &m.fallback_positive, &m.fallback_negative}) add(*g);
@@ -261,6 +271,11 @@ CalibrationNeeds calibration_needs(const FapSynthesisOptions &options) {
     if (!listed(h.expression ? options.only_expressions : options.only_visemes, h.number)) continue;
     add(h.muscles);
     need.jaw |= h.jaw_open > 0;
+  }
+  // A right muscle calibrates from its left twin's poses (face_model.h).
+  for (size_t i = 0, n = need.muscles.size(); i < n; ++i) {
+    const std::string &m = need.muscles[i];
+    if (m.size() > 6 && m.compare(m.size() - 6, 6, "_right") == 0) add({FapContraction{twin_name(m), 0}});
   }
   return need;
 }
@@ -331,17 +346,26 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     int side = +1;
     int reference = 0;        // FAP units along `side` (> 0)
     bool in_between = false;  // one of the mapping's `farther`
+    bool hidden = false;      // made only as a listed right FAP's mirror twin, not kept
   };
   const bool everything = lists_nothing(options);
   std::vector<Work> work;
+  // A listed right FAP's left twin is made too where it is not listed, and
+  // dropped after: the right one's target is then the one the whole AFM has
+  // (see twin_of below).
+  auto twin_listed = [&](const FapMapping &m) {
+    return !everything && model.mirror.symmetric() && m.driver == FapDriver::Muscles && twin_of_listed(options, m.fap);
+  };
   for (const FapMapping &m : fap_mappings()) {
     if (m.driver == FapDriver::Rigid || m.driver == FapDriver::None) continue;
-    if (!everything && !listed(options.only, m.fap)) continue;
-    work.push_back({&m, nullptr, +1, m.reference});
-    for (int r : m.farther) work.push_back({&m, nullptr, +1, r, true});
+    const bool hidden = twin_listed(m);
+    if (!everything && !listed(options.only, m.fap) && !hidden) continue;
+    work.push_back({&m, nullptr, +1, m.reference, false, hidden});
+    for (int r : m.farther)
+      if (!hidden) work.push_back({&m, nullptr, +1, r, true});
     const bool own_negative =
         !m.negative.empty() || (m.driver == FapDriver::Tongue && tongue_negative_target(m.fap));
-    if (options.negative_sides && own_negative) work.push_back({&m, nullptr, -1, m.reference});
+    if (options.negative_sides && own_negative) work.push_back({&m, nullptr, -1, m.reference, false, hidden});
   }
   for (const HighLevelMapping &h : high_level_mappings())
     if (everything || listed(h.expression ? options.only_expressions : options.only_visemes, h.number))
@@ -608,6 +632,88 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     t.displacement[static_cast<size_t>(pupil->part)] = D;
     res.target = std::move(t);
   };
+  // Mirror twins (anatomy/mirror.h). On a mirror-symmetric skin a right
+  // FAP's target waits for its left twin's (same side, reference, driver
+  // group mirrored) and, where the twin reached its value, starts from the
+  // twin's recipe: its group with the helpers the steering kept, its scale,
+  // and its pose mirrored. One solve of a few Newton iterations instead of
+  // the search and the steering rounds.
+  struct Recipe {
+    std::vector<std::pair<int, double>> pattern;  // the group and its helpers, percent before the scale
+    double scale = 0, cap = 0;
+    Pose pose;
+    // The FDP's distance from the prescribed motion that counts, model
+    // units: off the FAP's direction where the group reached its value, all
+    // of it where it stopped at its cap short of the value (`capped`, with
+    // `why` it stopped there).
+    double miss = 0;
+    bool faults = false;  // face_faults(...).any() of the pose
+    bool capped = false;
+    std::string why;
+  };
+  std::vector<int> twin_of(work.size(), -1);  // the left twin's work index (a first solve, see same_as)
+  std::vector<char> has_twin(work.size(), 0);
+  std::vector<std::optional<Recipe>> recipes(work.size());
+  auto miss_of = [&skin](const Pose &p, int vertex, const Eigen::Vector3d &along, double value, bool capped) {
+    const int node = skin.node(kEpidermis, vertex);
+    const Eigen::Vector3d m = (p.X.row(node) - skin.X0.row(node)).transpose();
+    return capped ? (m - value * along).norm() : (m - m.dot(along) * along).norm();
+  };
+  // The recipe mirrored onto `pattern` (this side's group, which must be the
+  // recipe's group mirrored), solved under the load control at the recipe's
+  // cap. Kept (into `pose` and `o`; true) where it ends as the twin's did
+  // (reaching the value, or at the cap short of it), turns no skin the
+  // twin's did not, and misses the prescribed motion by at most kSteerGain
+  // of the value more than the twin's (Recipe::miss).
+  auto from_twin = [&](const Recipe &r, const std::vector<std::pair<int, double>> &pattern, const PoseAction &action,
+                       double value, double unit_of, const Eigen::Vector3d &along, int vertex, FactorCache *cache,
+                       Pose &pose, FapOutcome &o) {
+    std::vector<std::pair<int, double>> with;
+    for (const auto &[i, pct] : r.pattern) {
+      const bool sided = !twin_name(model.muscles[static_cast<size_t>(i)].name).empty();
+      const int j = sided ? model.twin(i) : i;
+      if (j < 0) return false;
+      with.push_back({j, pct});
+    }
+    if (with.size() < pattern.size() || !std::equal(pattern.begin(), pattern.end(), with.begin())) return false;
+    Pose start;
+    start.X = mirrored_nodes(model, r.pose.X);
+    start.dynamic = mirrored_vertices(model, r.pose.dynamic);
+    SteerFrom from;
+    from.pose = &start;
+    from.scale = r.scale;
+    from.max_iterations = kBeyondIterations;
+    double scale = 0;
+    bool capped = false;
+    Expected<Pose> q = solve_pose_to(model, with, action, value, cache, &scale, r.cap, &capped, &from);
+    if (!q || capped != r.capped || miss_of(*q, vertex, along, value, r.capped) > r.miss + kSteerGain * value)
+      return false;
+    const double reach = action(q->X, nullptr);
+    if (r.capped && !(reach >= unit_of && reach < value)) return false;
+    if (!r.faults && face_faults(pose_epidermis(model, *q)).any()) return false;
+    pose = std::move(*q);
+    o.scale = scale;
+    o.mirrored = true;
+    if (r.capped) {
+      o.reached = reach / value;
+      char pct[32];
+      std::snprintf(pct, sizeof pct, "%.0f %%", 100 * o.reached);
+      o.message = std::string("reaches ") + pct + " of the prescribed motion: " + r.why + " (its mirror twin's finding)";
+    }
+    std::string helpers;
+    for (size_t h = pattern.size(); h < with.size(); ++h) {
+      char b[96];
+      std::snprintf(b, sizeof b, "%s%s %+.0f %%", helpers.empty() ? "" : ", ",
+                    model.muscles[static_cast<size_t>(with[h].first)].name.c_str(), scale * with[h].second);
+      helpers += b;
+    }
+    if (!helpers.empty()) {
+      char b[64];
+      std::snprintf(b, sizeof b, " (off-axis %.0f %%)", 100 * miss_of(pose, vertex, along, value, false) / value);
+      o.message += (o.message.empty() ? "" : "; ") + ("steered as its mirror twin by " + helpers + b);
+    }
+    return true;
+  };
   auto make = [&](size_t k) {
     Result &res = results[k];
     if (work[k].high) return make_high_level(*work[k].high, res);
@@ -821,152 +927,167 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
           return (X.row(node) - skin.X0.row(node)).dot(along.transpose());
         };
         FactorCache cache;
-        double scale = 0;
-        bool capped = false;
-        // Within the calibrated range first (s <= 1). A group that falls
-        // short there may pass it, its tensions extrapolated up to
-        // kMaxFapScale, in one more solve from the pose at s = 1 with a
-        // budget of Newton iterations; that pose is kept only if the skin
-        // stays a face. Where the skin already folds at s = 1, no more solve:
-        // on Song all 12 such groups folded beyond too, at about 18 Newton
-        // iterations each.
-        double cap = 1;
-        // The first guess: the muscles' calibrated poses added, scaled by the
-        // share that would bring the FDP to the value if the tissue were
-        // linear (within the range).
-        Activation group;
-        group.muscles = pattern;
-        const Pose sum = superposed_pose(model, group);
-        const double sum_action = action(sum.X, nullptr);
-        Pose guess = sum;
-        SteerFrom first;
-        if (sum_action > 0) {
-          first.scale = std::clamp(value / sum_action, 1.0 / 16, cap);
-          guess.X = skin.X0 + first.scale * (sum.X - skin.X0);
-          first.pose = &guess;
-        }
-        Expected<Pose> pz = solve_pose_to(model, pattern, action, value, &cache, &scale, cap, &capped,
-                                          first.pose ? &first : nullptr);
-        std::string beyond_why;  // why the group stayed within its range
-        if (pz && capped && face_faults(pose_epidermis(model, *pz)).any()) {
-          beyond_why = "the skin folds or sinks into the skull already at them";
-        } else if (pz && capped && action(pz->X, nullptr) <= 0) {
-          // The load control steers an action that grows with the load; one
-          // that fell at the range cannot be steered past it (Song's FAP 17:
-          // 40 Newton iterations, then a failed solve, 2.4 s of 34 s on one
-          // worker).
-          beyond_why = "beyond them nothing is tried: at them the FDP moves the wrong way";
-        } else if (pz && capped && action(pz->X, nullptr) < unit) {
-          // A group that moves its FDP less than a FAP unit at its range
-          // makes no target past it either (Song's FAP 64: 2 % of the
-          // reference at the range, then 0.7 s of CPU in two failed solves).
-          beyond_why = "beyond them nothing is tried: at them the FDP moves less than a FAP unit";
-        } else if (pz && capped) {
-          // From the pose at s = 1, within kBeyondIterations, s up to `up_to`.
-          auto past_range = [&](double up_to, double *s_out, bool *capped_out) {
-            SteerFrom from;
-            from.pose = &*pz;
-            from.scale = scale;
-            from.max_iterations = kBeyondIterations;
-            return solve_pose_to(model, pattern, action, value, &cache, s_out, up_to, capped_out, &from);
-          };
-          double s2 = 0;
-          bool capped2 = false;
-          Expected<Pose> beyond = past_range(kMaxFapScale, &s2, &capped2);
-          if (!beyond) {
-            beyond_why = "beyond it the solve fails";
-          } else if (face_faults(pose_epidermis(model, *beyond)).any()) {
-            // Short of the fold there may be a face. Where the chord from
-            // the pose at s = 1 to the folding one first folds guesses where
-            // the poses between do; one solve goes to 3/4 of that share of
-            // the way (s capped there, from the pose at s = 1). On Song, 9 %
-            // more Newton iterations for the whole AFM; to the whole share,
-            // then half of it where that folded, 17 % and less found; three
-            // bisection steps from the middle, a third more time. Not for a
-            // group that moves its FDP less than a FAP unit at s = 1:
-            // beyond, such a group moved Song's upper lip 6 times as far off
-            // the FAP's direction as along it.
-            beyond_why = "beyond it the skin folds or sinks into the skull";
-            if (action(pz->X, nullptr) >= unit) {
-              const Eigen::MatrixXd E1 = pose_epidermis(model, *pz), E2 = pose_epidermis(model, *beyond);
-              int steps = kChordSteps;  // of the chord that stay a face, at most
-              while (steps > 1 && face_faults(E1 + (steps * 1.0 / kChordSteps) * (E2 - E1)).any()) --steps;
-              const double share = kChordShare * steps / kChordSteps;
-              double s3 = 0;
-              bool capped3 = false;
-              Expected<Pose> p = past_range(scale + share * (s2 - scale), &s3, &capped3);
-              if (p && !face_faults(pose_epidermis(model, *p)).any()) {
-                pz = std::move(p);
-                scale = cap = s3;
-                char why[96];
-                std::snprintf(why, sizeof why, "at %.2g times them the skin folds or sinks into the skull", s2);
-                beyond_why = why;
+        // A right FAP whose left twin reached its value: its recipe mirrored
+        // first (from_twin). Else, or where that pose is worse than the
+        // twin's, the target is made as any other.
+        if (twin_of[k] >= 0 && recipes[static_cast<size_t>(twin_of[k])])
+          ok = from_twin(*recipes[static_cast<size_t>(twin_of[k])], pattern, action, value, unit, along, fdp->vertex,
+                         &cache, pose, o);
+        if (!ok) {
+          double scale = 0;
+          bool capped = false;
+          // Within the calibrated range first (s <= 1). A group that falls
+          // short there may pass it, its tensions extrapolated up to
+          // kMaxFapScale, in one more solve from the pose at s = 1 with a
+          // budget of Newton iterations; that pose is kept only if the skin
+          // stays a face. Where the skin already folds at s = 1, no more solve:
+          // on Song all 12 such groups folded beyond too, at about 18 Newton
+          // iterations each.
+          double cap = 1;
+          // The first guess: the muscles' calibrated poses added, scaled by the
+          // share that would bring the FDP to the value if the tissue were
+          // linear (within the range).
+          Activation group;
+          group.muscles = pattern;
+          const Pose sum = superposed_pose(model, group);
+          const double sum_action = action(sum.X, nullptr);
+          Pose guess = sum;
+          SteerFrom first;
+          if (sum_action > 0) {
+            first.scale = std::clamp(value / sum_action, 1.0 / 16, cap);
+            guess.X = skin.X0 + first.scale * (sum.X - skin.X0);
+            first.pose = &guess;
+          }
+          Expected<Pose> pz = solve_pose_to(model, pattern, action, value, &cache, &scale, cap, &capped,
+                                            first.pose ? &first : nullptr);
+          std::string beyond_why;  // why the group stayed within its range
+          if (pz && capped && face_faults(pose_epidermis(model, *pz)).any()) {
+            beyond_why = "the skin folds or sinks into the skull already at them";
+          } else if (pz && capped && action(pz->X, nullptr) <= 0) {
+            // The load control steers an action that grows with the load; one
+            // that fell at the range cannot be steered past it (Song's FAP 17:
+            // 40 Newton iterations, then a failed solve, 2.4 s of 34 s on one
+            // worker).
+            beyond_why = "beyond them nothing is tried: at them the FDP moves the wrong way";
+          } else if (pz && capped && action(pz->X, nullptr) < unit) {
+            // A group that moves its FDP less than a FAP unit at its range
+            // makes no target past it either (Song's FAP 64: 2 % of the
+            // reference at the range, then 0.7 s of CPU in two failed solves).
+            beyond_why = "beyond them nothing is tried: at them the FDP moves less than a FAP unit";
+          } else if (pz && capped) {
+            // From the pose at s = 1, within kBeyondIterations, s up to `up_to`.
+            auto past_range = [&](double up_to, double *s_out, bool *capped_out) {
+              SteerFrom from;
+              from.pose = &*pz;
+              from.scale = scale;
+              from.max_iterations = kBeyondIterations;
+              return solve_pose_to(model, pattern, action, value, &cache, s_out, up_to, capped_out, &from);
+            };
+            double s2 = 0;
+            bool capped2 = false;
+            Expected<Pose> beyond = past_range(kMaxFapScale, &s2, &capped2);
+            if (!beyond) {
+              beyond_why = "beyond it the solve fails";
+            } else if (face_faults(pose_epidermis(model, *beyond)).any()) {
+              // Short of the fold there may be a face. Where the chord from
+              // the pose at s = 1 to the folding one first folds guesses where
+              // the poses between do; one solve goes to 3/4 of that share of
+              // the way (s capped there, from the pose at s = 1). On Song, 9 %
+              // more Newton iterations for the whole AFM; to the whole share,
+              // then half of it where that folded, 17 % and less found; three
+              // bisection steps from the middle, a third more time. Not for a
+              // group that moves its FDP less than a FAP unit at s = 1:
+              // beyond, such a group moved Song's upper lip 6 times as far off
+              // the FAP's direction as along it.
+              beyond_why = "beyond it the skin folds or sinks into the skull";
+              if (action(pz->X, nullptr) >= unit) {
+                const Eigen::MatrixXd E1 = pose_epidermis(model, *pz), E2 = pose_epidermis(model, *beyond);
+                int steps = kChordSteps;  // of the chord that stay a face, at most
+                while (steps > 1 && face_faults(E1 + (steps * 1.0 / kChordSteps) * (E2 - E1)).any()) --steps;
+                const double share = kChordShare * steps / kChordSteps;
+                double s3 = 0;
+                bool capped3 = false;
+                Expected<Pose> p = past_range(scale + share * (s2 - scale), &s3, &capped3);
+                if (p && !face_faults(pose_epidermis(model, *p)).any()) {
+                  pz = std::move(p);
+                  scale = cap = s3;
+                  char why[96];
+                  std::snprintf(why, sizeof why, "at %.2g times them the skin folds or sinks into the skull", s2);
+                  beyond_why = why;
+                }
               }
-            }
-          } else {
-            pz = std::move(beyond);
-            scale = s2, capped = capped2, cap = kMaxFapScale;
-          }
-        }
-        // Where the group's pose drifts off the FAP's direction, helpers
-        // steer the FDP back (steer.h). Not on a fallback group.
-        std::string steered;
-        if (pz && !fallback && !map->helpers.empty() && options.steer)
-          steered = steer_group(model, map->helpers, pattern, fdp->vertex, side * dir, action, value, cap, &cache,
-                                face_faults, *pz, scale, capped);
-        if (pz && !capped) {
-          pose = std::move(*pz);
-          o.scale = scale;
-          ok = true;
-        } else {
-          // The target is then the most the group does at the cap. Where
-          // the load control failed (the FDP moves the wrong way), a plain
-          // pose says how far and which way.
-          const std::string why = !pz                 ? pz.status().message()
-                                  : !beyond_why.empty() ? "the table's contractions reach less, and " + beyond_why
-                                                        : "the group reaches less at " +
-                                                              std::to_string(static_cast<int>(kMaxFapScale)) +
-                                                              " times the table's contractions";
-          const bool at_cap = static_cast<bool>(pz);
-          Expected<Pose> full = std::move(pz);
-          if (!full) {
-            Activation a;
-            a.muscles = pattern;
-            PoseOptions po;
-            po.start = &sum;
-            full = solve_pose(model, a, &cache, po);
-          }
-          if (!full) {
-            o.message = full.status().message();
-          } else {
-            const double reach = action(full->X, nullptr);
-            const int r = static_cast<int>(std::floor(reach / unit));
-            if (r < 1) {
-              o.message = reach <= 0 ? "the group moves the FDP the wrong way"
-                                     : "the group moves the FDP less than a FAP unit";
-              o.message += " (reference " + std::to_string(reference) + ": " + why + ")";
             } else {
-              // Kept at the table's reference: the target is the most the
-              // group does, so streams at the reference see the muscles at
-              // their range instead of a small target extrapolated many times.
-              pose = std::move(*full);
-              o.scale = at_cap ? cap : 1;
-              if (reach >= value) {
-                // The load control stopped at the cap just short of the value,
-                // and the equilibrium there lies beyond it: scale the few
-                // percent back.
-                shrink = value / reach;
-              } else {
-                o.reached = reach / value;
-                char pct[32];
-                std::snprintf(pct, sizeof pct, "%.0f %%", 100 * o.reached);
-                o.message = std::string("reaches ") + pct + " of the prescribed motion: " + why;
-              }
-              ok = true;
+              pz = std::move(beyond);
+              scale = s2, capped = capped2, cap = kMaxFapScale;
             }
           }
+          // Where the group's pose drifts off the FAP's direction, helpers
+          // steer the FDP back (steer.h). Not on a fallback group.
+          std::string steered;
+          std::vector<std::pair<int, double>> steered_pattern = pattern;
+          if (pz && !fallback && !map->helpers.empty() && options.steer)
+            steered = steer_group(model, map->helpers, pattern, fdp->vertex, side * dir, action, value, cap, &cache,
+                                  face_faults, *pz, scale, capped, &steered_pattern);
+          if (pz && !capped) {
+            pose = std::move(*pz);
+            o.scale = scale;
+            ok = true;
+            if (has_twin[k] && !fallback)
+              recipes[k] = Recipe{steered_pattern, scale, cap, pose, miss_of(pose, fdp->vertex, along, value, false),
+                                  face_faults(pose_epidermis(model, pose)).any(), false, std::string()};
+          } else {
+            // The target is then the most the group does at the cap. Where
+            // the load control failed (the FDP moves the wrong way), a plain
+            // pose says how far and which way.
+            const std::string why = !pz                 ? pz.status().message()
+                                    : !beyond_why.empty() ? "the table's contractions reach less, and " + beyond_why
+                                                          : "the group reaches less at " +
+                                                                std::to_string(static_cast<int>(kMaxFapScale)) +
+                                                                " times the table's contractions";
+            const bool at_cap = static_cast<bool>(pz);
+            Expected<Pose> full = std::move(pz);
+            if (!full) {
+              Activation a;
+              a.muscles = pattern;
+              PoseOptions po;
+              po.start = &sum;
+              full = solve_pose(model, a, &cache, po);
+            }
+            if (!full) {
+              o.message = full.status().message();
+            } else {
+              const double reach = action(full->X, nullptr);
+              const int r = static_cast<int>(std::floor(reach / unit));
+              if (r < 1) {
+                o.message = reach <= 0 ? "the group moves the FDP the wrong way"
+                                       : "the group moves the FDP less than a FAP unit";
+                o.message += " (reference " + std::to_string(reference) + ": " + why + ")";
+              } else {
+                // Kept at the table's reference: the target is the most the
+                // group does, so streams at the reference see the muscles at
+                // their range instead of a small target extrapolated many times.
+                pose = std::move(*full);
+                o.scale = at_cap ? cap : 1;
+                if (reach >= value) {
+                  // The load control stopped at the cap just short of the value,
+                  // and the equilibrium there lies beyond it: scale the few
+                  // percent back.
+                  shrink = value / reach;
+                } else {
+                  o.reached = reach / value;
+                  char pct[32];
+                  std::snprintf(pct, sizeof pct, "%.0f %%", 100 * o.reached);
+                  o.message = std::string("reaches ") + pct + " of the prescribed motion: " + why;
+                  if (has_twin[k] && !fallback && at_cap)
+                    recipes[k] = Recipe{steered_pattern, scale, cap, pose, miss_of(pose, fdp->vertex, along, value, true),
+                                        face_faults(pose_epidermis(model, pose)).any(), true, why};
+                }
+                ok = true;
+              }
+            }
+          }
+          if (ok && !steered.empty()) o.message += (o.message.empty() ? "" : "; ") + steered;
         }
-        if (ok && !steered.empty()) o.message += (o.message.empty() ? "" : "; ") + steered;
       }
     }
     if (ok && o.in_between && o.reached < 1) {
@@ -1034,11 +1155,39 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     for (size_t j = 0; keys[k] && j < k && same_as[k] == k; ++j)
       if (same_as[j] == j && keys[j] == keys[k]) same_as[k] = j;
   }
+  if (model.mirror.symmetric())
+    for (size_t k = 0; k < work.size(); ++k) {
+      if (same_as[k] != k || !work[k].fap || work[k].fap->driver != FapDriver::Muscles || work[k].in_between) continue;
+      const std::string left = left_fap_name(afm_fap(work[k].fap->fap)->name);
+      if (left.empty()) continue;
+      for (size_t j = 0; j < work.size(); ++j)
+        if (work[j].fap && !work[j].in_between && work[j].side == work[k].side &&
+            work[j].reference == work[k].reference && left == afm_fap(work[j].fap->fap)->name) {
+          twin_of[k] = static_cast<int>(same_as[j]);
+          has_twin[same_as[j]] = 1;
+        }
+    }
+  // The twins' targets first, in the work list's order; a right one that
+  // finds its twin still running waits for it.
+  std::vector<size_t> order;
+  for (size_t k = 0; k < work.size(); ++k)
+    if (twin_of[k] < 0) order.push_back(k);
+  for (size_t k = 0; k < work.size(); ++k)
+    if (twin_of[k] >= 0) order.push_back(k);
+  std::vector<char> finished(work.size(), 0);
+  std::condition_variable finished_one;
   std::mutex lock;
   int done = 0;
-  for_each_task(work.size(), options.threads, [&](size_t k) {
+  for_each_task(order.size(), options.threads, [&](size_t j) {
+    const size_t k = order[j];
+    if (twin_of[k] >= 0) {
+      std::unique_lock<std::mutex> g(lock);
+      finished_one.wait(g, [&] { return finished[static_cast<size_t>(twin_of[k])] != 0; });
+    }
     if (same_as[k] == k) make(k);
     std::lock_guard<std::mutex> g(lock);
+    finished[k] = 1;
+    finished_one.notify_all();
     if (options.progress)
       options.progress(++done, static_cast<int>(work.size()),
                        work[k].high ? high_level_label(*work[k].high) : fap_label(work[k].fap->fap, work[k].side));
@@ -1058,6 +1207,11 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       r.target->reference = r.outcome.reference;
     }
   }
+  for (size_t k = work.size(); k-- > 0;)
+    if (work[k].hidden) {
+      work.erase(work.begin() + static_cast<std::ptrdiff_t>(k));
+      results.erase(results.begin() + static_cast<std::ptrdiff_t>(k));
+    }
   // A FAP side's in-betweens go on past its nearer targets: one made at
   // the value where the lids meet is dropped when that value is not past
   // them (an eye opened less than a 600 in-between).

@@ -108,7 +108,8 @@ std::string steer_group(const FaceModel &model, const std::vector<std::string> &
                         const std::vector<std::pair<int, double>> &pattern, int vertex, const Eigen::Vector3d &along,
                         const PoseAction &action, double value, double cap, FactorCache *cache,
                         const std::function<SkinFaults(const Eigen::MatrixXd &)> &faults, Pose &pose, double &scale,
-                        bool &capped) {
+                        bool &capped, std::vector<std::pair<int, double>> *steered_pattern) {
+  if (steered_pattern) *steered_pattern = pattern;
   const std::vector<HelperColumn> columns = helper_columns(model, names, pattern, vertex);
   if (columns.empty()) return std::string();
   const int node = model.tissue.node(kEpidermis, vertex);
@@ -173,6 +174,7 @@ std::string steer_group(const FaceModel &model, const std::vector<std::string> &
     const bool small = off_now - off_q < kSteerGain * value;
     pose = std::move(*q);
     scale = s2, capped = capped2;
+    if (steered_pattern) *steered_pattern = with;
     off_now = off_q, faults_now = faults_q;
     c = reached;
     if (small) break;

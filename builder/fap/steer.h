@@ -126,7 +126,9 @@ void steer_update(SteerModel &model, const std::vector<double> &from, const std:
 // corrected and the choice made again; the steering stops after a round
 // that gains less than kSteerGain of `value`, a choice the model says
 // gains less, a failed solve, or kSteerRounds rounds. Out: the pose,
-// scale and capped of the last round kept (as they were when none is).
+// scale and capped of the last round kept (as they were when none is), and
+// *steered_pattern (when given) the pattern it was solved with: `pattern`
+// and the helpers, in percent before the scale (`pattern` when none is).
 // Returns "steered by NAME +C %, ... (off-axis A % -> B %)", contractions
 // in percent of each helper's range and off-axis shares of `value` (with
 // ", along A % -> B %" where a group short of its value got further), or
@@ -135,6 +137,6 @@ std::string steer_group(const FaceModel &model, const std::vector<std::string> &
                         const std::vector<std::pair<int, double>> &pattern, int vertex, const Eigen::Vector3d &along,
                         const PoseAction &action, double value, double cap, FactorCache *cache,
                         const std::function<SkinFaults(const Eigen::MatrixXd &)> &faults, Pose &pose, double &scale,
-                        bool &capped);
+                        bool &capped, std::vector<std::pair<int, double>> *steered_pattern = nullptr);
 
 }  // namespace afmb

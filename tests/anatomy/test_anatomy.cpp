@@ -421,6 +421,94 @@ TEST(Muscles, AllPlacedSymmetricallyOnTheReferenceHead) {
   }
 }
 
+// The reference head is symmetric vertex for vertex: every skin vertex has
+// its image (anatomy/mirror.h), the images pair up both ways, and each lies
+// within the tolerance of the reflection. A vertex moved off it loses its
+// image, and a skin with a fifth of its vertices moved is not symmetric.
+TEST(Mirror, TheReferenceHeadsSkinPairsUpAndAMovedVertexLosesItsImage) {
+  const FaceModel &m = head_1k().model;
+  ASSERT_TRUE(m.mirror.symmetric());
+  const SkinModel &s = m.tissue;
+  const Eigen::MatrixXd V = s.X0.topRows(s.n);
+  const FdpPoint *l = m.fdps.find(FdpId{3, 5}), *r = m.fdps.find(FdpId{3, 6});
+  ASSERT_TRUE(l && r);
+  const double tolerance = kMirrorTolerance * (l->pos - r->pos).norm();
+  int paired = 0, used = 0;
+  for (int v = 0; v < s.n; ++v) {
+    if (!s.in_mesh[static_cast<size_t>(v)]) continue;
+    ++used;
+    const int u = m.mirror.image[static_cast<size_t>(v)];
+    if (u < 0) continue;
+    ++paired;
+    EXPECT_EQ(m.mirror.image[static_cast<size_t>(u)], v);
+    Eigen::Vector3d reflected = V.row(v).transpose();
+    reflected.x() = 2 * m.mirror.mid - reflected.x();
+    EXPECT_LE((reflected - V.row(u).transpose()).norm(), tolerance) << v;
+  }
+  EXPECT_EQ(paired, used);
+
+  // Vertex 0 moved by ten tolerances across the face: neither it nor its
+  // old image pairs.
+  Eigen::MatrixXd W = V;
+  const int old_image = m.mirror.image[0];
+  W(0, 0) += 10 * tolerance;
+  const SkinMirror moved = skin_mirror(W, s.in_mesh, m.mirror.mid, tolerance);
+  ASSERT_TRUE(moved.symmetric());
+  EXPECT_EQ(moved.image[0], -1);
+  if (old_image != 0) {
+    EXPECT_EQ(moved.image[static_cast<size_t>(old_image)], -1);
+  }
+  // Every fifth vertex moved: not symmetric.
+  for (int v = 0; v < s.n; v += 5) W(v, 1) += 10 * tolerance;
+  EXPECT_FALSE(skin_mirror(W, s.in_mesh, m.mirror.mid, tolerance).symmetric());
+  // Mirrored twice, a displacement of every node comes back.
+  Eigen::MatrixXd X = s.X0;
+  for (Eigen::Index g = 0; g < X.rows(); ++g)
+    X.row(g) += Eigen::RowVector3d(std::sin(1.0 * g), std::cos(2.0 * g), std::sin(3.0 * g));
+  const Eigen::MatrixXd back = mirrored_nodes(m, mirrored_nodes(m, X));
+  EXPECT_LT((back - X).cwiseAbs().maxCoeff(), 1e-9);
+  // Once, a node takes its image's motion with x turned.
+  const Eigen::MatrixXd once = mirrored_nodes(m, X);
+  const int u = m.mirror.image[0], g = s.node(kDermis, 0), h = s.node(kDermis, u);
+  EXPECT_NEAR(once(g, 0) - s.X0(g, 0), -(X(h, 0) - s.X0(h, 0)), 1e-12);
+  EXPECT_NEAR(once(g, 1) - s.X0(g, 1), X(h, 1) - s.X0(h, 1), 1e-12);
+}
+
+// A right muscle calibrated from its left twin's poses mirrored
+// (face_model.h) meets the table's action as one calibrated from rest does:
+// the same tensions to a thousandth, the same key-node action to the
+// tolerance, the same pose to a quantum.
+TEST(Physics, ARightMuscleCalibratedFromItsTwinMatchesOneCalibratedFromRest) {
+  FaceModelOptions both, alone;
+  both.calibrate_only = {"zygomaticus_major_left", "zygomaticus_major_right"};
+  alone.calibrate_only = {"zygomaticus_major_right"};
+  both.calibrate_jaw = alone.calibrate_jaw = false;
+  const std::unique_ptr<Built> a = afmtest::build_reference_model(1000, both);
+  const std::unique_ptr<Built> b = afmtest::build_reference_model(1000, alone);
+  ASSERT_TRUE(a && b);
+  const Muscle &ma = a->model.muscles[static_cast<size_t>(a->model.find("zygomaticus_major_right"))];
+  const Muscle &mb = b->model.muscles[static_cast<size_t>(b->model.find("zygomaticus_major_right"))];
+  ASSERT_GT(ma.tension_max, 0);
+  EXPECT_NEAR(ma.tension_max / mb.tension_max, 1, 1e-3);
+  EXPECT_NEAR(ma.tension_min / mb.tension_min, 1, 1e-3);
+  const SkinModel &s = a->model.tissue;
+  for (bool maximum : {true, false}) {
+    const NodeDisplacement &ra = maximum ? ma.response_max : ma.response_min;
+    const NodeDisplacement &rb = maximum ? mb.response_max : mb.response_min;
+    Eigen::MatrixXd Xa = s.X0, Xb = s.X0;
+    for (size_t i = 0; i < ra.nodes.size(); ++i) Xa.row(ra.nodes[i]) += ra.displacement.row(static_cast<Eigen::Index>(i));
+    for (size_t i = 0; i < rb.nodes.size(); ++i) Xb.row(rb.nodes[i]) += rb.displacement.row(static_cast<Eigen::Index>(i));
+    const double target = muscle_action_target(ma, maximum);
+    EXPECT_NEAR(muscle_action(s, ma, Xa, nullptr), target, a->model.solver.tolerance) << maximum;
+    EXPECT_NEAR(muscle_action(s, mb, Xb, nullptr), target, a->model.solver.tolerance) << maximum;
+    const double apart = (Xa - Xb).rowwise().norm().maxCoeff() / a->model.quantum;
+    EXPECT_LT(apart, 1) << "quanta apart, side " << maximum;
+    EXPECT_GT(apart, 0) << "started from the twin, not from rest as the other";
+    std::printf("  %s: %.3f quanta apart, tensions %.6g / %.6g\n", maximum ? "+100 %" : "-100 %", apart,
+                maximum ? ma.tension_max : ma.tension_min, maximum ? mb.tension_max : mb.tension_min);
+  }
+}
+
 // Equations 1 and 2 on Song, whose lips are closed and whose eye openings
 // face down-forward at their rims: orbicularis oris covers both lips (the
 // midpoints 8.1, 8.2 and the corners 8.3, 8.4) and each orbicularis oculi

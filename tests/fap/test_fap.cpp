@@ -17,6 +17,7 @@
 #include "afm/afm_export.h"
 #include "anatomy/face_model.h"
 #include "anatomy/jaw.h"
+#include "anatomy/mirror.h"
 #include "anatomy/muscle_table.h"
 #include "anatomy/muscles.h"
 #include "anatomy/pupil.h"
@@ -1295,6 +1296,73 @@ TEST(FapSynthesis, AModelCalibratedOnlyForItsTargetsMakesTheSameTargets) {
     ++compared;
   }
   EXPECT_EQ(compared, 2);
+}
+
+// Mirror twins (fap_synthesis.h). The reference head is mirror-symmetric,
+// so FAP 13 (the right corner raised) is made from FAP 12's recipe, one
+// solve from its pose mirrored, on both sides. Each is the target the whole
+// search and steering make on the same model without its mirror, within a
+// quantum (0.5 and 0.01), and the mirror image of FAP 12's within 1 % of
+// its largest motion (1.3 and 2.3 quanta of 660-760); and FAP 13 listed
+// alone, or on one worker (it then waits for no twin), is made from its
+// twin all the same, bit for bit.
+TEST(FapSynthesis, ARightFapIsMadeFromItsLeftTwinAsTheWholeSearchMakesIt) {
+  FapSynthesisOptions o;
+  o.only = {12, 13};
+  o.threads = 2;
+  const CalibrationNeeds need = calibration_needs(o);
+  FapSynthesisOptions right = o;
+  right.only = {13};
+  EXPECT_EQ(calibration_needs(right).muscles.size(), need.muscles.size()) << "FAP 12's muscles too";
+  FaceModelOptions fo;
+  fo.calibrate_only = need.muscles;
+  fo.calibrate_jaw = false;
+  const std::unique_ptr<Built> b = afmtest::build_reference_model(1000, fo);
+  ASSERT_TRUE(b);
+  const FaceModel &m = b->model;
+  ASSERT_TRUE(m.mirror.symmetric());
+  Expected<FapSynthesis> twins = synthesize_faps(b->head.scene, m, o);
+  Expected<FapSynthesis> alone = synthesize_faps(b->head.scene, m, right);
+  FapSynthesisOptions one = o;
+  one.threads = 1;
+  Expected<FapSynthesis> serial = synthesize_faps(b->head.scene, m, one);
+  ASSERT_TRUE(serial.is_ok() && serial->targets.size() == 4u);
+  FaceModel plain = m;
+  plain.mirror = SkinMirror();
+  Expected<FapSynthesis> searched = synthesize_faps(b->head.scene, plain, right);
+  ASSERT_TRUE(twins.is_ok() && alone.is_ok() && searched.is_ok());
+  ASSERT_EQ(twins->targets.size(), 4u);
+  ASSERT_EQ(alone->targets.size(), 2u);
+  ASSERT_EQ(searched->targets.size(), 2u);
+  const size_t skin = static_cast<size_t>(m.skin);
+  for (int side : {+1, -1}) {
+    const size_t l = side > 0 ? 0 : 1, r = side > 0 ? 2 : 3;  // FAP 12 +, 12 -, 13 +, 13 -
+    ASSERT_EQ(twins->outcomes[r].number, 13);
+    EXPECT_TRUE(twins->outcomes[r].mirrored) << side;
+    EXPECT_FALSE(twins->outcomes[l].mirrored) << side;
+    EXPECT_FALSE(searched->outcomes[side > 0 ? 0 : 1].mirrored) << side;
+    const Eigen::MatrixXd &D12 = twins->targets[l].displacement[skin], &D13 = twins->targets[r].displacement[skin];
+    EXPECT_EQ(D13, alone->targets[side > 0 ? 0 : 1].displacement[skin]) << "bit for bit, side " << side;
+    EXPECT_EQ(D13, serial->targets[r].displacement[skin]) << "bit for bit, side " << side;
+    // Against the mirror image of FAP 12's target and the searched one.
+    double from_image = 0;
+    for (int v = 0; v < m.tissue.n; ++v) {
+      const int u = m.mirror.image[static_cast<size_t>(v)];
+      if (u < 0) continue;
+      Eigen::RowVector3d d = D12.row(u);
+      d.x() = -d.x();
+      from_image = std::max(from_image, (D13.row(v) - d).norm());
+    }
+    const Eigen::MatrixXd &S13 = searched->targets[side > 0 ? 0 : 1].displacement[skin];
+    const double from_search = (D13 - S13).rowwise().norm().maxCoeff();
+    std::printf("  side %+d: %.3f quanta from FAP 12's image, %.3f from the searched target (largest motion %.1f quanta)\n",
+                side, from_image / m.quantum, from_search / m.quantum, D13.rowwise().norm().maxCoeff() / m.quantum);
+    EXPECT_LT(from_image, 0.01 * D13.rowwise().norm().maxCoeff()) << side;
+    EXPECT_LT(from_search, m.quantum) << side;
+    // The FDP rule holds as for any target.
+    const FapOutcome &out = twins->outcomes[r];
+    EXPECT_LT(out.along_error, 0.02) << side;
+  }
 }
 
 using DocPtr = std::unique_ptr<afm_doc, void (*)(afm_doc *)>;
