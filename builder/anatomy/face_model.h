@@ -17,8 +17,8 @@
 // is exact to the solver tolerance. On a mirror-symmetric skin
 // (FaceModel::mirror) a right muscle whose left twin is calibrated too
 // waits for it and starts from the twin's calibrated poses mirrored, at its
-// tensions, on its set joined with the twin's V_d mirrored (Song: 2 to 7
-// Newton iterations a side instead of 3 to 13; the calibrations' CPU 2.7 ->
+// tensions, on its set joined with the twin's V_d mirrored (Song: mostly 2 to 7
+// Newton iterations a side instead of 4 to 14; the calibrations' CPU 2.7 ->
 // 2.2 s).
 //
 // Dynamic node sets (section 3.2.4): every solve runs on a set of skin
