@@ -634,10 +634,11 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
   };
   // Mirror twins (anatomy/mirror.h). On a mirror-symmetric skin a right
   // FAP's target waits for its left twin's (same side, reference, driver
-  // group mirrored) and, where the twin reached its value, starts from the
-  // twin's recipe: its group with the helpers the steering kept, its scale,
-  // and its pose mirrored. One solve of a few Newton iterations instead of
-  // the search and the steering rounds.
+  // group mirrored) and, where the twin reached its value or stopped at its
+  // cap short of it, starts from the twin's recipe: its group with the
+  // helpers the steering kept, its scale and cap, and its pose mirrored. One
+  // solve of a few Newton iterations instead of the search and the steering
+  // rounds.
   struct Recipe {
     std::vector<std::pair<int, double>> pattern;  // the group and its helpers, percent before the scale
     double scale = 0, cap = 0;
@@ -927,9 +928,9 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
           return (X.row(node) - skin.X0.row(node)).dot(along.transpose());
         };
         FactorCache cache;
-        // A right FAP whose left twin reached its value: its recipe mirrored
-        // first (from_twin). Else, or where that pose is worse than the
-        // twin's, the target is made as any other.
+        // A right FAP whose left twin left a recipe: that mirrored first
+        // (from_twin). Else, or where that pose is worse than the twin's, the
+        // target is made as any other.
         if (twin_of[k] >= 0 && recipes[static_cast<size_t>(twin_of[k])])
           ok = from_twin(*recipes[static_cast<size_t>(twin_of[k])], pattern, action, value, unit, along, fdp->vertex,
                          &cache, pose, o);
