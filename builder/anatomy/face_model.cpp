@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <condition_variable>
 #include <mutex>
 
 #include "afm/afm_export.h"
@@ -238,10 +237,12 @@ Eigen::MatrixXd carried_rest(const FaceModel &model, const Eigen::Affine3d &jaw)
 // *torn (when given): the pose that gets there tears the skin
 // (SkinFaults::tears); the tension is set all the same.
 // With `twin` (the muscle's calibrated twin on a mirror-symmetric skin, at
-// the same range), the solve starts from the twin's pose mirrored, at its
-// tension, on the set joined with the twin's V_d mirrored.
+// the same range; index into model.muscles, -1: none), the solve starts from
+// the twin's pose mirrored, at its tension, on the set joined with the
+// twin's V_d mirrored.
 Status calibrate_side(const FaceModel &model, Muscle &m, bool maximum, FactorCache *cache, std::vector<int> &set,
-                      bool *locked, bool *torn, const Muscle *twin = nullptr) {
+                      bool *locked, bool *torn, int twin_index = -1) {
+  const Muscle *twin = twin_index >= 0 ? &model.muscles[static_cast<size_t>(twin_index)] : nullptr;
   LoadControl control;
   control.unit_load = unit_load(model, m, maximum ? 1.0 : -1.0);
   control.action = [&](const Eigen::MatrixXd &X, Eigen::MatrixXd *g) { return muscle_action(model.tissue, m, X, g); };
@@ -250,12 +251,12 @@ Status calibrate_side(const FaceModel &model, Muscle &m, bool maximum, FactorCac
   if (opts.kind == SolverKind::ImplicitEuler) opts.kind = SolverKind::Newton;  // it cannot solve for a tension
   Eigen::MatrixXd X = model.tissue.X0;
   if (twin && (maximum ? twin->range_max == m.range_max : twin->range_min == m.range_min)) {
-    const NodeDisplacement &r = maximum ? twin->response_max : twin->response_min;
-    Eigen::MatrixXd Xt = model.tissue.X0;
-    for (size_t i = 0; i < r.nodes.size(); ++i) Xt.row(r.nodes[i]) += r.displacement.row(static_cast<Eigen::Index>(i));
-    X = mirrored_nodes(model, Xt);
+    Activation a;
+    a.muscles = {{twin_index, maximum ? 100.0 : -100.0}};
+    const Pose t = superposed_pose(model, a);  // the twin's calibrated pose
+    X = mirrored_nodes(model, t.X);
     control.tension = maximum ? twin->tension_max : twin->tension_min;
-    join(set, mirrored_vertices(model, twin->dynamic));
+    join(set, mirrored_vertices(model, t.dynamic));
   }
   Status s = solve_growing(model, set, nullptr, model.tissue.X0, X, opts, model.wave_threshold, cache, false,
                            nullptr, nullptr, &control);
@@ -396,14 +397,12 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
   // On a mirror-symmetric skin, a right muscle whose left twin is
   // calibrated too starts from its poses mirrored (calibrate_side): a few
   // Newton iterations instead of a solve from rest. The right ones come
-  // last, and one whose twin is still running waits for it (tasks are
-  // taken in order, so the twin is running or done).
+  // last, and one whose twin is still running waits for it.
   std::vector<int> twin_task(tasks, -1);
   if (model.mirror.symmetric())
     for (size_t k = 0; k < todo.size(); ++k) {
       const int t = model.twin(static_cast<int>(todo[k]));
-      const std::string &name = model.muscles[todo[k]].name;
-      if (t < 0 || name.size() < 6 || name.compare(name.size() - 6, 6, "_right") != 0) continue;
+      if (t < 0 || !right_side(model.muscles[todo[k]].name)) continue;
       for (size_t j = 0; j < todo.size(); ++j)
         if (todo[j] == static_cast<size_t>(t)) twin_task[k] = static_cast<int>(j);
     }
@@ -413,17 +412,15 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
     if ((twin_task[a] >= 0) != (twin_task[b] >= 0)) return twin_task[b] >= 0;
     return weight(a) > weight(b);
   });
-  std::vector<char> calibrated(tasks, 0);
-  std::condition_variable calibrated_one;
+  std::vector<int> position(tasks), after(tasks, -1);  // in `order`
+  for (size_t j = 0; j < tasks; ++j) position[order[j]] = static_cast<int>(j);
+  for (size_t j = 0; j < tasks; ++j)
+    if (const int t = twin_task[order[j]]; t >= 0) after[j] = position[static_cast<size_t>(t)];
   std::mutex lock;
   int finished = 0;
   const int total = static_cast<int>(tasks);
-  for_each_task(tasks, options.threads, [&](size_t j) {
+  for_each_task_after(tasks, options.threads, after, [&](size_t j) {
     const size_t k = order[j];
-    if (twin_task[k] >= 0) {
-      std::unique_lock<std::mutex> g(lock);
-      calibrated_one.wait(g, [&] { return calibrated[static_cast<size_t>(twin_task[k])] != 0; });
-    }
     FactorCache cache;
     std::string what = "jaw";
     if (k < todo.size()) {
@@ -438,7 +435,7 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
       // its range is what the FAPs rely on).
       const bool essential = table[static_cast<size_t>(m.def)].essential;
       const int t = twin_task[k];
-      const Muscle *twin = t >= 0 && result[static_cast<size_t>(t)] ? &model.muscles[todo[static_cast<size_t>(t)]] : nullptr;
+      const int twin = t >= 0 && result[static_cast<size_t>(t)] ? static_cast<int>(todo[static_cast<size_t>(t)]) : -1;
       auto side = [&](bool maximum) {
         bool locked = false, torn = false;
         int &why = cut[todo[k]][maximum ? 1 : 0];
@@ -465,8 +462,6 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
       jaw_pose = solve_pose(model, open, &cache);
     }
     std::lock_guard<std::mutex> g(lock);
-    calibrated[k] = 1;
-    calibrated_one.notify_all();
     progress(++finished, total, what);
   });
 

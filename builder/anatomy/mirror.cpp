@@ -49,14 +49,18 @@ std::vector<std::vector<int>> image_candidates(const Eigen::MatrixXd &V, double 
   return out;
 }
 
-}  // namespace
-
-std::vector<int> mirror_vertices(const Eigen::MatrixXd &V, double mid, double tolerance) {
-  const std::vector<std::vector<int>> near = image_candidates(V, mid, tolerance);
+// Each row's nearest candidate, or -1.
+std::vector<int> nearest(const std::vector<std::vector<int>> &near) {
   std::vector<int> out(near.size(), -1);
   for (size_t v = 0; v < near.size(); ++v)
     if (!near[v].empty()) out[v] = near[v].front();
   return out;
+}
+
+}  // namespace
+
+std::vector<int> mirror_vertices(const Eigen::MatrixXd &V, double mid, double tolerance) {
+  return nearest(image_candidates(V, mid, tolerance));
 }
 
 SkinMirror skin_mirror(const Eigen::MatrixXd &V, const std::vector<uint8_t> &used, double mid_guess, double tolerance,
@@ -66,12 +70,12 @@ SkinMirror skin_mirror(const Eigen::MatrixXd &V, const std::vector<uint8_t> &use
   int total = 0;
   for (int v = 0; v < n; ++v) total += counts(v) ? 1 : 0;
   SkinMirror out;
-  std::vector<int> image = mirror_vertices(V, mid_guess, tolerance);
+  const std::vector<std::vector<int>> near = image_candidates(V, mid_guess, tolerance);
+  std::vector<int> image = nearest(near);
   if (neighbours) {
     // Where vertices coincide (a seam, the corners of a slit), the nearest
     // is no answer: the candidate whose neighbours are the images of most
     // of v's neighbours is.
-    const std::vector<std::vector<int>> near = image_candidates(V, mid_guess, tolerance);
     for (int v = 0; v < n; ++v) {
       const std::vector<int> &cs = near[static_cast<size_t>(v)];
       if (cs.size() < 2) continue;
@@ -110,6 +114,11 @@ std::string twin_name(const std::string &muscle) {
       return muscle.substr(0, muscle.size() - n) + to;
   }
   return std::string();
+}
+
+bool right_side(const std::string &muscle) {
+  const size_t n = std::char_traits<char>::length("_right");
+  return muscle.size() > n && muscle.compare(muscle.size() - n, n, "_right") == 0;
 }
 
 }  // namespace afmb

@@ -48,5 +48,7 @@ SkinMirror skin_mirror(const Eigen::MatrixXd &V, const std::vector<uint8_t> &use
 // A muscle's twin on the other side: "..._left" for "..._right" and back;
 // "" for a muscle on the midline.
 std::string twin_name(const std::string &muscle);
+// Whether a muscle is on the right side ("..._right").
+bool right_side(const std::string &muscle);
 
 }  // namespace afmb

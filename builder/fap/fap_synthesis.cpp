@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <condition_variable>
 #include <cstdio>
 #include <mutex>
 #include <optional>
@@ -39,6 +38,13 @@ constexpr double kChordShare = 0.75;
 // Bisection steps on the share of a viseme's or expression's pose that
 // keeps the skin a face: to a sixteenth.
 constexpr int kShareSteps = 4;
+// "reaches N % of the prescribed motion: why", reached a share (0..1).
+std::string reaches_message(double reached, const std::string &why) {
+  char pct[32];
+  std::snprintf(pct, sizeof pct, "%.0f %%", 100 * reached);
+  return std::string("reaches ") + pct + " of the prescribed motion: " + why;
+}
+
 // The left twin's name of a right FAP ("raise_r_cornerlip",
 // "lower_t_lip_rm"), else "".
 std::string left_fap_name(const std::string &name) {
@@ -273,10 +279,8 @@ CalibrationNeeds calibration_needs(const FapSynthesisOptions &options) {
     need.jaw |= h.jaw_open > 0;
   }
   // A right muscle calibrates from its left twin's poses (face_model.h).
-  for (size_t i = 0, n = need.muscles.size(); i < n; ++i) {
-    const std::string &m = need.muscles[i];
-    if (m.size() > 6 && m.compare(m.size() - 6, 6, "_right") == 0) add({FapContraction{twin_name(m), 0}});
-  }
+  for (size_t i = 0, n = need.muscles.size(); i < n; ++i)
+    if (right_side(need.muscles[i])) add({FapContraction{twin_name(need.muscles[i]), 0}});
   return need;
 }
 
@@ -697,9 +701,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     o.mirrored = true;
     if (r.capped) {
       o.reached = reach / value;
-      char pct[32];
-      std::snprintf(pct, sizeof pct, "%.0f %%", 100 * o.reached);
-      o.message = std::string("reaches ") + pct + " of the prescribed motion: " + r.why + " (its mirror twin's finding)";
+      o.message = reaches_message(o.reached, r.why + " (its mirror twin's finding)");
     }
     std::string helpers;
     for (size_t h = pattern.size(); h < with.size(); ++h) {
@@ -1076,9 +1078,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
                   shrink = value / reach;
                 } else {
                   o.reached = reach / value;
-                  char pct[32];
-                  std::snprintf(pct, sizeof pct, "%.0f %%", 100 * o.reached);
-                  o.message = std::string("reaches ") + pct + " of the prescribed motion: " + why;
+                  o.message = reaches_message(o.reached, why);
                   if (has_twin[k] && !fallback && at_cap)
                     recipes[k] = Recipe{steered_pattern, scale, cap, pose, miss_of(pose, fdp->vertex, along, value, true),
                                         face_faults(pose_epidermis(model, pose)).any(), true, why};
@@ -1175,20 +1175,16 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     if (twin_of[k] < 0) order.push_back(k);
   for (size_t k = 0; k < work.size(); ++k)
     if (twin_of[k] >= 0) order.push_back(k);
-  std::vector<char> finished(work.size(), 0);
-  std::condition_variable finished_one;
+  std::vector<int> position(work.size()), after(order.size(), -1);  // in `order`
+  for (size_t j = 0; j < order.size(); ++j) position[order[j]] = static_cast<int>(j);
+  for (size_t j = 0; j < order.size(); ++j)
+    if (const int t = twin_of[order[j]]; t >= 0) after[j] = position[static_cast<size_t>(t)];
   std::mutex lock;
   int done = 0;
-  for_each_task(order.size(), options.threads, [&](size_t j) {
+  for_each_task_after(order.size(), options.threads, after, [&](size_t j) {
     const size_t k = order[j];
-    if (twin_of[k] >= 0) {
-      std::unique_lock<std::mutex> g(lock);
-      finished_one.wait(g, [&] { return finished[static_cast<size_t>(twin_of[k])] != 0; });
-    }
     if (same_as[k] == k) make(k);
     std::lock_guard<std::mutex> g(lock);
-    finished[k] = 1;
-    finished_one.notify_all();
     if (options.progress)
       options.progress(++done, static_cast<int>(work.size()),
                        work[k].high ? high_level_label(*work[k].high) : fap_label(work[k].fap->fap, work[k].side));
