@@ -61,13 +61,17 @@ bool BlockLdlt::analyze(const SpMat &pattern) {
   // L's column counts: row k of L is the reach of column k's upper part.
   flag_.assign(static_cast<size_t>(nodes), -1);
   std::vector<int> count(static_cast<size_t>(nodes), 0);
+  row_start_.assign(static_cast<size_t>(nodes) + 1, 0);
   for (int k = 0; k < nodes; ++k) {
     flag_[static_cast<size_t>(k)] = k;
+    int in_row = 0;
     for (const UpperBlock &b : upper_[static_cast<size_t>(k)])
       for (int i = b.row; flag_[static_cast<size_t>(i)] != k; i = parent_[static_cast<size_t>(i)]) {
         ++count[static_cast<size_t>(i)];
+        ++in_row;
         flag_[static_cast<size_t>(i)] = k;
       }
+    row_start_[static_cast<size_t>(k) + 1] = row_start_[static_cast<size_t>(k)] + in_row;
   }
   col_start_.assign(static_cast<size_t>(nodes) + 1, 0);
   for (int i = 0; i < nodes; ++i) {
@@ -93,6 +97,8 @@ BlockLdlt::Result BlockLdlt::factorize(const SpMat &K) {
   const double *val = K.valuePtr();
   std::fill(flag_.begin(), flag_.end(), -1);
   std::fill(filled_.begin(), filled_.end(), 0);
+  lrf_.resize(static_cast<size_t>(row_start_.back()));
+  rcol_.resize(static_cast<size_t>(row_start_.back()));
   bool definite = true;
   for (int k = 0; k < nodes_; ++k) {
     const int old = order_[static_cast<size_t>(k)];
@@ -124,6 +130,10 @@ BlockLdlt::Result BlockLdlt::factorize(const SpMat &K) {
       dk.noalias() -= lki * yi;
       row_[static_cast<size_t>(end)] = k;
       l_[static_cast<size_t>(end)] = lki;
+      const size_t slot = static_cast<size_t>(row_start_[static_cast<size_t>(k)] + (p - top));
+      lrf_[slot].setZero();
+      lrf_[slot].topRows<3>() = lki.cast<float>();
+      rcol_[slot] = static_cast<int>(i);
       ++filled_[i];
     }
     const Eigen::LDLT<M3> pivots(dk);
@@ -134,42 +144,67 @@ BlockLdlt::Result BlockLdlt::factorize(const SpMat &K) {
     if (!d_inverse_[static_cast<size_t>(k)].allFinite()) return Result::kSingular;
   }
   lf_.resize(l_.size());
-  for (size_t q = 0; q < l_.size(); ++q) lf_[q] = l_[q].cast<float>();
+  for (size_t q = 0; q < l_.size(); ++q) {
+    lf_[q].setZero();
+    lf_[q].topRows<3>() = l_[q].transpose().cast<float>();
+  }
   df_.resize(d_inverse_.size());
-  for (size_t q = 0; q < d_inverse_.size(); ++q) df_[q] = d_inverse_[q].cast<float>();
+  for (size_t q = 0; q < d_inverse_.size(); ++q) {
+    df_[q].setZero();
+    df_[q].topRows<3>() = d_inverse_[q].cast<float>();
+  }
   return definite ? Result::kDefinite : Result::kIndefinite;
 }
 
-namespace {
-
-// x = P^T L^-T D^-1 L^-1 P b with the factors' blocks `l` (per L block) and
-// `d` (D's inverse per node), in their scalar type; z is work space.
-template <class Blocks, class Vectors>
-void substitute(const std::vector<int> &order, const std::vector<int> &col_start, const std::vector<int> &row,
-                const Blocks &l, const Blocks &d, Vectors &z, const Eigen::VectorXd &b, Eigen::VectorXd &x) {
-  using Scalar = typename Vectors::value_type::Scalar;
-  const size_t n = order.size();
-  z.resize(n);
-  for (size_t i = 0; i < n; ++i) z[i] = b.segment<3>(3 * order[i]).template cast<Scalar>();
-  for (size_t i = 0; i < n; ++i)
-    for (int q = col_start[i]; q < col_start[i + 1]; ++q)
-      z[static_cast<size_t>(row[static_cast<size_t>(q)])].noalias() -= l[static_cast<size_t>(q)] * z[i];
-  for (size_t i = 0; i < n; ++i) z[i] = d[i] * z[i];
-  for (size_t i = n; i-- > 0;)
-    for (int q = col_start[i]; q < col_start[i + 1]; ++q)
-      z[i].noalias() -= l[static_cast<size_t>(q)].transpose() * z[static_cast<size_t>(row[static_cast<size_t>(q)])];
-  x.resize(b.size());
-  for (size_t i = 0; i < n; ++i) x.segment<3>(3 * order[i]) = z[i].template cast<double>();
-}
-
-}  // namespace
-
+// x = P^T L^-T D^-1 L^-1 P b.
 void BlockLdlt::solve(const Eigen::VectorXd &b, Eigen::VectorXd &x) const {
-  substitute(order_, col_start_, row_, l_, d_inverse_, solve_work_, b, x);
+  std::vector<Eigen::Vector3d> &z = solve_work_;
+  const size_t n = order_.size();
+  z.resize(n);
+  for (size_t i = 0; i < n; ++i) z[i] = b.segment<3>(3 * order_[i]);
+  for (size_t i = 0; i < n; ++i)
+    for (int q = col_start_[i]; q < col_start_[i + 1]; ++q)
+      z[static_cast<size_t>(row_[static_cast<size_t>(q)])].noalias() -= l_[static_cast<size_t>(q)] * z[i];
+  for (size_t i = 0; i < n; ++i) z[i] = d_inverse_[i] * z[i];
+  for (size_t i = n; i-- > 0;)
+    for (int q = col_start_[i]; q < col_start_[i + 1]; ++q)
+      z[i].noalias() -= l_[static_cast<size_t>(q)].transpose() * z[static_cast<size_t>(row_[static_cast<size_t>(q)])];
+  x.resize(b.size());
+  for (size_t i = 0; i < n; ++i) x.segment<3>(3 * order_[i]) = z[i];
 }
 
+// As solve(), in single precision.
 void BlockLdlt::precondition(const Eigen::VectorXd &b, Eigen::VectorXd &x) const {
-  substitute(order_, col_start_, row_, lf_, df_, solve_work_f_, b, x);
+  std::vector<V4f, Eigen::aligned_allocator<V4f>> &z = solve_work_f_;
+  const size_t n = order_.size();
+  z.resize(n);
+  // Forward by rows: row k's sum stays in a register, where a pass by
+  // columns would read and write z once per block.
+  for (size_t k = 0; k < n; ++k) {
+    V4f acc(static_cast<float>(b[3 * order_[k]]), static_cast<float>(b[3 * order_[k] + 1]),
+            static_cast<float>(b[3 * order_[k] + 2]), 0.f);
+    for (int e = row_start_[k]; e < row_start_[k + 1]; ++e) {
+      const M43f &l = lrf_[static_cast<size_t>(e)];
+      const V4f &zi = z[static_cast<size_t>(rcol_[static_cast<size_t>(e)])];
+      acc -= l.col(0) * zi[0] + l.col(1) * zi[1] + l.col(2) * zi[2];
+    }
+    z[k] = acc;
+  }
+  for (size_t i = 0; i < n; ++i) {
+    const V4f zi = z[i];
+    z[i] = df_[i].col(0) * zi[0] + df_[i].col(1) * zi[1] + df_[i].col(2) * zi[2];
+  }
+  for (size_t i = n; i-- > 0;) {
+    V4f acc = z[i];
+    for (int q = col_start_[i]; q < col_start_[i + 1]; ++q) {
+      const M43f &l = lf_[static_cast<size_t>(q)];
+      const V4f &zq = z[static_cast<size_t>(row_[static_cast<size_t>(q)])];
+      acc -= l.col(0) * zq[0] + l.col(1) * zq[1] + l.col(2) * zq[2];
+    }
+    z[i] = acc;
+  }
+  x.resize(b.size());
+  for (size_t i = 0; i < n; ++i) x.segment<3>(3 * order_[i]) = z[i].head<3>().cast<double>();
 }
 
 }  // namespace afmb

@@ -314,63 +314,103 @@ void add_tie(double *values, const std::array<Block, 4> &bl, const Eigen::Matrix
   if (bl[2].base >= 0) add_block(values, bl[2], -B), add_block(values, bl[3], -B);
 }
 
-// The Hessian at X into K (the system's pattern): springs, the shape term and
-// the volume term. `diag` gets its diagonal. Not `full` (the projected
-// tangent): the indefinite parts are dropped (a compressed spring's negative
-// transverse stiffness, the volume's own curvature k_v (V - V0) / |V0|
-// d2V/dp2, leaving its Gauss-Newton part), which keeps K positive
-// semi-definite everywhere; `full`, Newton converges quadratically near an
-// equilibrium, where K is definite anyway.
-void linearise(const System &sys, const Eigen::MatrixXd &X, SpMat &K, Vec &diag, bool full = false) {
+// The internal force at X into *r (dofs; the shape term pulls toward `ref`)
+// and/or the Hessian into *K (the system's pattern) and *diag (its
+// diagonal), in one pass over the springs and elements: a Newton step needs
+// both at the same X. Either pair may be null. The Hessian: springs, the
+// shape term and the volume term. Not `full` (the projected tangent): the
+// indefinite parts are dropped (a compressed spring's negative transverse
+// stiffness, the volume's own curvature k_v (V - V0) / |V0| d2V/dp2, leaving
+// its Gauss-Newton part), which keeps K positive semi-definite everywhere;
+// `full`, Newton converges quadratically near an equilibrium, where K is
+// definite anyway.
+void assemble(const System &sys, const Eigen::MatrixXd &X, const Eigen::MatrixXd *ref, Vec *r, SpMat *K, Vec *diag,
+              bool full) {
   const SkinModel &m = sys.m;
-  if (K.nonZeros() != sys.pattern.nonZeros()) K = sys.pattern;
-  double *val = K.valuePtr();
-  std::fill(val, val + K.nonZeros(), 0.0);
+  if (r) r->setZero(sys.dofs());
+  double *val = nullptr;
+  if (K) {
+    if (K->nonZeros() != sys.pattern.nonZeros()) *K = sys.pattern;
+    val = K->valuePtr();
+    std::fill(val, val + K->nonZeros(), 0.0);
+  }
   for (size_t q = 0; q < sys.springs.size(); ++q) {
     const Spring &s = m.springs[static_cast<size_t>(sys.springs[q])];
     const Eigen::Vector3d d = X.row(s.b) - X.row(s.a);
     const double l = std::max(d.norm(), 1e-12 * s.rest);
-    const Eigen::Vector3d u = d / l;
     double t, dt;
     tension(s, m.stiffness(s), l, &t, &dt);
-    const double geo = (t >= 0 || full ? t : 0.0) / l;
-    const Eigen::Matrix3d B = (dt - geo) * u * u.transpose() + geo * Eigen::Matrix3d::Identity();
-    add_tie(val, sys.tie_blocks[q], B);
+    if (r) {
+      const Eigen::Vector3d f = t * d / l;  // pulls a toward b when stretched
+      const int la = sys.local[static_cast<size_t>(s.a)], lb = sys.local[static_cast<size_t>(s.b)];
+      if (la >= 0) r->segment<3>(3 * la) += f;
+      if (lb >= 0) r->segment<3>(3 * lb) -= f;
+    }
+    if (K) {
+      const Eigen::Vector3d u = d / l;
+      const double geo = (t >= 0 || full ? t : 0.0) / l;
+      const Eigen::Matrix3d B = (dt - geo) * u * u.transpose() + geo * Eigen::Matrix3d::Identity();
+      add_tie(val, sys.tie_blocks[q], B);
+    }
   }
-  // Lip pairs: d2E/ds2 up up^T, up = +y (lip_contact.h).
+  // Lip pairs: the force pushes the upper vertex up; d2E/ds2 up up^T, up = +y
+  // (lip_contact.h).
   for (size_t i = 0; i < sys.lips.size(); ++i) {
     const LipPair &p = m.lip_pairs[static_cast<size_t>(sys.lips[i])];
-    const double c = lip_contact_energy(p, X(p.upper, 1) - X(p.lower, 1)).d2;
-    if (c <= 0) continue;
-    Eigen::Matrix3d B = Eigen::Matrix3d::Zero();
-    B(1, 1) = c;
-    add_tie(val, sys.tie_blocks[sys.springs.size() + i], B);
+    const LipContactValue c = lip_contact_energy(p, X(p.upper, 1) - X(p.lower, 1));
+    if (r && c.d1 != 0) {
+      const int la = sys.local[static_cast<size_t>(p.upper)], lb = sys.local[static_cast<size_t>(p.lower)];
+      if (la >= 0) (*r)[3 * la + 1] -= c.d1;
+      if (lb >= 0) (*r)[3 * lb + 1] += c.d1;
+    }
+    if (K && c.d2 > 0) {
+      Eigen::Matrix3d B = Eigen::Matrix3d::Zero();
+      B(1, 1) = c.d2;
+      add_tie(val, sys.tie_blocks[sys.springs.size() + i], B);
+    }
   }
   Eigen::Matrix<double, 9, 3> g, gs[3];
   VolumeHessian H;
+  auto push = [&](const Element &el, double c, const Eigen::Matrix<double, 9, 3> &grad) {
+    for (int k = 0; k < 9; ++k)
+      if (el.local[k] >= 0) r->segment<3>(3 * el.local[k]) += c * grad.row(k).transpose();
+  };
   for (size_t e = 0; e < sys.elements.size(); ++e) {
     const Element &el = sys.elements[e];
     double excess = 0;  // k_v (V - V0) / |V0|: the weight of the volume's own curvature
     if (el.weight > 0) {
       const double v = element_volume(m, X, el.f, &g);
-      if (full) excess = el.weight * (v - m.rest_volume[el.f]);
+      if (r) push(el, -el.weight * (v - m.rest_volume[el.f]), g);
+      if (K && full) excess = el.weight * (v - m.rest_volume[el.f]);
       if (excess != 0) element_volume_hessian(m, X, el.f, &H);
     }
-    // Squeezed slabs: the floor's Gauss-Newton part w psi''(J) / V0^2 grad
-    // grad^T, in both tangents. Its own curvature w psi'(J) / V0 d2V/dp2 is
-    // left out of the full one too: with it the full tangent turned
-    // indefinite more often (Song's AFM at k_c = 0.3: 2,816 factorisations
-    // against 2,030).
+    // Squeezed slabs: the floor's force, and its Gauss-Newton part
+    // w psi''(J) / V0^2 grad grad^T in both tangents. Its own curvature
+    // w psi'(J) / V0 d2V/dp2 is left out of the full one too: with it the
+    // full tangent turned indefinite more often (Song's AFM at k_c = 0.3:
+    // 2,816 factorisations against 2,030).
     int squeezed = 0;
     double gauss[3];
     for (int sl = 0; sl < 3; ++sl) {
       if (el.collapse[sl] <= 0) continue;
       const double v0 = el.slab_rest[sl];
       const FloorValue p = slab_floor(m, X, el, sl);
-      if (p.d2 <= 0) continue;
+      const bool pushes = r && p.d1 != 0, stiffens = K && p.d2 > 0;
+      if (!pushes && !stiffens) continue;
       element_volume(m, X, el.f, &gs[squeezed], sl);
-      gauss[squeezed++] = el.collapse[sl] * p.d2 / (v0 * v0);
+      if (pushes) push(el, -el.collapse[sl] * p.d1 / v0, gs[squeezed]);
+      if (stiffens) gauss[squeezed++] = el.collapse[sl] * p.d2 / (v0 * v0);
     }
+    if (r && el.shape > 0) {
+      Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+      for (int k = 0; k < 12; ++k) mean += (X.row(el.global[k]) - ref->row(el.global[k])).transpose();
+      mean /= 12.0;
+      for (int k = 0; k < 9; ++k)
+        if (el.local[k] >= 0)
+          r->segment<3>(3 * el.local[k]) -=
+              el.shape * ((X.row(el.global[k]) - ref->row(el.global[k])).transpose() - mean);
+    }
+    if (!K) continue;
     // Block (j, i) is written as the transpose of block (i, j), so that K is
     // symmetric to the last bit (and half the blocks are made).
     for (int i = 0; i < 9; ++i)
@@ -385,11 +425,17 @@ void linearise(const System &sys, const Eigen::MatrixXd &X, SpMat &K, Vec &diag,
         if (j != i) add_block(val, sys.element_blocks[81 * e + static_cast<size_t>(9 * j + i)], B.transpose());
       }
   }
-  diag.resize(sys.dofs());
+  if (!K) return;
+  diag->resize(sys.dofs());
   for (size_t i = 0; i < sys.diagonal.size(); ++i) {
     const Block b = sys.diagonal[i];
-    for (int r = 0; r < 3; ++r) diag[3 * static_cast<Eigen::Index>(i) + r] = val[b.base + r * b.stride + r];
+    for (int q = 0; q < 3; ++q) (*diag)[3 * static_cast<Eigen::Index>(i) + q] = val[b.base + q * b.stride + q];
   }
+}
+
+// The Hessian alone (assemble()).
+void linearise(const System &sys, const Eigen::MatrixXd &X, SpMat &K, Vec &diag, bool full = false) {
+  assemble(sys, X, nullptr, nullptr, &K, &diag, full);
 }
 
 // Adds the load's Hessian (ForceField) at X to K and diag.
@@ -417,62 +463,17 @@ void scatter_rows(const System &sys, const Vec &x, Eigen::MatrixXd &P) {
   for (size_t i = 0; i < sys.nodes.size(); ++i) P.row(sys.nodes[i]) = x.segment<3>(3 * static_cast<int>(i)).transpose();
 }
 
-// Internal plus external force on the free nodes.
+// Internal plus external force on the free nodes; with K and diag, the
+// internal Hessian too (assemble()) and the load's.
 void net_force(const System &sys, const ForceField &forces, const Eigen::MatrixXd &ref,
-               const Eigen::MatrixXd &X, Vec &r) {
-  const SkinModel &m = sys.m;
-  r.setZero(sys.dofs());
-  for (int si : sys.springs) {
-    const Spring &s = m.springs[static_cast<size_t>(si)];
-    const Eigen::Vector3d d = X.row(s.b) - X.row(s.a);
-    const double l = std::max(d.norm(), 1e-12 * s.rest);
-    double t, dt;
-    tension(s, m.stiffness(s), l, &t, &dt);
-    const Eigen::Vector3d f = t * d / l;  // pulls a toward b when stretched
-    const int la = sys.local[static_cast<size_t>(s.a)], lb = sys.local[static_cast<size_t>(s.b)];
-    if (la >= 0) r.segment<3>(3 * la) += f;
-    if (lb >= 0) r.segment<3>(3 * lb) -= f;
-  }
-  for (size_t i = 0; i < sys.lips.size(); ++i) {
-    const LipPair &p = m.lip_pairs[static_cast<size_t>(sys.lips[i])];
-    const double f = -lip_contact_energy(p, X(p.upper, 1) - X(p.lower, 1)).d1;  // pushes the upper vertex up
-    if (f == 0) continue;
-    const int la = sys.local[static_cast<size_t>(p.upper)], lb = sys.local[static_cast<size_t>(p.lower)];
-    if (la >= 0) r[3 * la + 1] += f;
-    if (lb >= 0) r[3 * lb + 1] -= f;
-  }
-  Eigen::Matrix<double, 9, 3> g;
-  for (const Element &el : sys.elements) {
-    if (el.weight > 0) {
-      const double v = element_volume(m, X, el.f, &g);
-      const double c = -el.weight * (v - m.rest_volume[el.f]);
-      for (int k = 0; k < 9; ++k)
-        if (el.local[k] >= 0) r.segment<3>(3 * el.local[k]) += c * g.row(k).transpose();
-    }
-    for (int sl = 0; sl < 3; ++sl) {
-      if (el.collapse[sl] <= 0) continue;
-      const double v0 = el.slab_rest[sl];
-      const FloorValue p = slab_floor(m, X, el, sl);
-      if (p.d1 == 0) continue;
-      element_volume(m, X, el.f, &g, sl);
-      const double c = -el.collapse[sl] * p.d1 / v0;
-      for (int k = 0; k < 9; ++k)
-        if (el.local[k] >= 0) r.segment<3>(3 * el.local[k]) += c * g.row(k).transpose();
-    }
-    if (el.shape > 0) {
-      Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-      for (int k = 0; k < 12; ++k) mean += (X.row(el.global[k]) - ref.row(el.global[k])).transpose();
-      mean /= 12.0;
-      for (int k = 0; k < 9; ++k)
-        if (el.local[k] >= 0)
-          r.segment<3>(3 * el.local[k]) -= el.shape * ((X.row(el.global[k]) - ref.row(el.global[k])).transpose() - mean);
-    }
-  }
+               const Eigen::MatrixXd &X, Vec &r, SpMat *K = nullptr, Vec *diag = nullptr, bool full = false) {
+  assemble(sys, X, &ref, &r, K, diag, full);
   if (forces) {
     Eigen::MatrixXd F = Eigen::MatrixXd::Zero(X.rows(), 3);
     forces(X, &F, nullptr);
     r += gather_rows(sys, F);
   }
+  if (K) add_load_stiffness(sys, forces, X, *K, *diag);
 }
 
 // Total potential energy of the system: springs, volume, external load.
@@ -938,10 +939,8 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
   double known_energy = 0;
   for (int it = 0;; ++it) {
     const ForceField load = load_at(t);
-    net_force(sys, load, reference, X, r);
+    net_force(sys, load, reference, X, r, &K, &diag, true);
     if (!finite(r)) return done(false, name + ": non-finite force");
-    linearise(sys, X, K, diag, true);
-    add_load_stiffness(sys, load, X, K, diag);
     Vec rf = r;
     contacts.filter(rf);
     st.residual = displacement_estimate(rf, diag);
