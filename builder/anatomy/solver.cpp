@@ -837,11 +837,8 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     add_load_stiffness(sys, forces, X, K, diag);
     Vec v = Vec::Zero(n), dv, Kv(n), b(n);
     for (int step = 0; step < max_steps; ++step) {
-      net_force(sys, forces, reference, X, r);
-      if (step > 0) {
-        linearise(sys, X, K, diag);
-        add_load_stiffness(sys, forces, X, K, diag);
-      }
+      // The first step's tangent is the one linearised above.
+      net_force(sys, forces, reference, X, r, step > 0 ? &K : nullptr, &diag);
       st.residual = displacement_estimate([&] { Vec f = r; contacts.filter(f); return f; }(), diag);
       if (!finite(r)) return done(false, "implicit-euler: non-finite force at step " + std::to_string(step));
       if (step > 0 && st.residual < tol && st.last_step < tol) {
