@@ -104,6 +104,10 @@
 //   the last update moved no node more than tol, and the Jacobi estimate of
 //   the remaining displacement, max over unknowns |r_i| / K_ii (residual
 //   force over the diagonal stiffness), is below tol.
+// The newton solvers measure it before a step too: where the estimate is
+// below tol and the Newton step (under load control, with the action's
+// linearised gap after it) is too, that step is taken whole and the solve
+// ends, without a line search and another force and tangent to confirm.
 // A solve that does not meet it within max_iterations, or meets a non-finite
 // number, fails; so does a newton solve whose remaining displacement has not
 // fallen below half its best for 60 iterations (it cycles: the generated
