@@ -69,7 +69,9 @@
 //                   from the pattern: deterministic); a CG run past a whole
 //                   factorisation's worth stops and the step starts over
 //                   with a fresh one. The fill-reducing
-//                   ordering is computed once per dynamic set (FactorCache).
+//                   ordering is computed once per dynamic set (FactorCache),
+//                   and a solve on a set starts with the factorisation the
+//                   last solve there ended on.
 //                   A backtracking (Armijo) line search on the total energy;
 //                   a whole step made on the projected or shifted tangent,
 //                   which is stiffer than the skin along the modes that
@@ -196,8 +198,10 @@ using ForceField = std::function<double(const Eigen::MatrixXd &X, Eigen::MatrixX
 // Per dynamic set (and skin model) and lip contact (on or off: with it the
 // lip pairs join the pattern, and their coupling of the two lips costs
 // fill-in in every factorisation): the unknowns, the Hessian's sparsity
-// pattern, its fill-reducing ordering, and the rest-state factorisation once
-// a solver needed it; reused by every solve on the same set. Not
+// pattern, its fill-reducing ordering, the last newton factorisation, and
+// the rest-state factorisation once a solver needed it; reused by every
+// solve on the same set, so results depend on the order of the solves made
+// with one cache (keep that order fixed for deterministic output). Not
 // thread-safe: one cache per thread.
 class FactorCache {
  public:
