@@ -1635,6 +1635,36 @@ TEST(Solver, InexactNewtonStepsReachTheSameEquilibrium) {
   EXPECT_LT(sc[0].cg_iterations, sc[1].cg_iterations);
 }
 
+TEST(Solver, ASolveStartingWithTheLastSolvesFactorisationEndsWhereAFreshOneDoes) {
+  // A second solve on a set (a target's search past its range) starts with
+  // the factorisation the first ended on (FactorCache): the same equilibrium
+  // as a solve with a cache of its own, within the stopping rule's slack,
+  // and at least one factorisation fewer.
+  const FaceModel &m = head_1k().model;
+  const Muscle &mu = m.muscles[static_cast<size_t>(m.find("zygomaticus_major_left"))];
+  auto load = [&](double t) {
+    return ForceField([&m, &mu, t](const Eigen::MatrixXd &X, Eigen::MatrixXd *F, NodeBlocks *K) {
+      return muscle_load(m.tissue, mu, t, X, F, K);
+    });
+  };
+  const std::vector<int> set = all_vertices(m.tissue);
+  FactorCache shared, own;
+  Eigen::MatrixXd first = m.tissue.X0, second = m.tissue.X0, fresh = m.tissue.X0;
+  const SolveStats s1 = solve_equilibrium(m.tissue, set, load(0.3), m.tissue.X0, first, m.solver, &shared);
+  ASSERT_TRUE(s1.converged) << s1.message;
+  const SolveStats s2 = solve_equilibrium(m.tissue, set, load(0.5), m.tissue.X0, second, m.solver, &shared);
+  const SolveStats sf = solve_equilibrium(m.tissue, set, load(0.5), m.tissue.X0, fresh, m.solver, &own);
+  ASSERT_TRUE(s2.converged) << s2.message;
+  ASSERT_TRUE(sf.converged) << sf.message;
+  EXPECT_GT((fresh - m.tissue.X0).cwiseAbs().maxCoeff(), 20 * m.solver.tolerance);  // it moved
+  EXPECT_LT((second - fresh).cwiseAbs().maxCoeff(), 2 * m.solver.tolerance);
+  EXPECT_LT(s2.factorisations, sf.factorisations);
+  std::printf("from the last solve's factorisation: %d factorisations, %d Newton and %d CG iterations; "
+              "fresh: %d, %d and %d; apart by %.2f tolerances\n",
+              s2.factorisations, s2.iterations, s2.cg_iterations, sf.factorisations, sf.iterations,
+              sf.cg_iterations, (second - fresh).cwiseAbs().maxCoeff() / m.solver.tolerance);
+}
+
 TEST(Solver, ALoadThatMovesTheActionTheWrongWayFailsAtOnce) {
   // Load control from a tension already found (a solve beyond a FAP's
   // range starts so): the step clamp halves the tension each iteration
