@@ -1027,9 +1027,9 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
         Kf = K;
         contacts.filter(sys, Kf);
         const Ldlt::Result res = entry->symbolic.factorize(Kf);
-        entry->factored = res != Ldlt::Result::kSingular;
         ++st.factorisations;
         const bool ok = res != Ldlt::Result::kSingular;
+        entry->factored = ok;
         if (ok && (!full || res == Ldlt::Result::kDefinite)) break;
         if (!full) return false;
         if (projected_run >= 2 && shifted()) break;
@@ -1119,11 +1119,12 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     // taken whole and ends the solve, without the line search's energy and
     // another force and tangent to confirm (a solve's last iteration; Song's
     // AFM 3 % less CPU, the same reports).
-    if (it > 0 && st.residual < tol && max_node_motion(dx) < tol &&
+    if (const double motion = max_node_motion(dx);
+        it > 0 && st.residual < tol && motion < tol &&
         (!control || control->capped || std::abs(action + cgrad.dot(dx) - control->value) < tol)) {
       scatter_rows(sys, gather_rows(sys, X) + dx, X);
       const double held = update_contacts(sys, X, contacts);
-      st.last_step = std::max(max_node_motion(dx), held);
+      st.last_step = std::max(motion, held);
       st.iterations = it + 1;
       energy_known = false;
       if (st.last_step < tol) break;
