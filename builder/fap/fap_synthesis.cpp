@@ -1282,11 +1282,12 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
   }
   // The slivers a target turns over are untangled (untangle.h). A FAP's
   // FDP keeps the motion it was measured by, and the skin the solver holds
-  // off an eyeball stays as solved: a patch of Song's closing upper lid,
-  // moved affinely, left a hole in it.
+  // off an eyeball is held: a patch of Song's closing upper lid, moved
+  // affinely, left a hole in it; only a sliver's corner there may move.
   const Eigen::MatrixXd rest = skin.X0.topRows(skin.n);
-  std::vector<char> held(static_cast<size_t>(skin.n), 0);
-  for (int v = 0; v < skin.n; ++v) held[static_cast<size_t>(v)] = skin.eye_near[static_cast<size_t>(v)] >= 0;
+  std::vector<char> held(static_cast<size_t>(skin.n), kUntangleFree);
+  for (int v = 0; v < skin.n; ++v)
+    if (skin.eye_near[static_cast<size_t>(v)] >= 0) held[static_cast<size_t>(v)] = kUntangleHeld;
   for (size_t k = 0; k < results.size(); ++k) {
     Result &r = results[k];
     if (r.target && r.target->displacement[static_cast<size_t>(model.skin)].rows() == 0) {
@@ -1294,17 +1295,18 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     } else if (r.target) {
       MorphTarget &t = *r.target;
       Eigen::MatrixXd &D = t.displacement[static_cast<size_t>(model.skin)];
-      std::vector<char> fixed = held;
+      std::vector<char> hold = held;
       if (const FapMapping *f = work[k].fap)
-        if (const int fdp = fdp_vertex(model, afm_fap(f->fap)); fdp >= 0) fixed[static_cast<size_t>(fdp)] = 1;
-      const Untangled u = untangle(rest, skin.F, fixed, options.sim, D);
+        if (const int fdp = fdp_vertex(model, afm_fap(f->fap)); fdp >= 0)
+          hold[static_cast<size_t>(fdp)] = kUntangleFixed;
+      const Untangled u = untangle(rest, skin.F, hold, options.sim, D);
       if (u.moved > 0) {
         for (const SkinBinding &b : carried) t.displacement[static_cast<size_t>(b.part)] = Eigen::MatrixXd();
         carry(D, t);
         char what[160];
         std::snprintf(what, sizeof what,
-                      "untangled %d of %d turned triangles: %d vertices move in patches, each affinely "
-                      "or as one piece, changed by %.2g at most",
+                      "untangled %d of %d turned triangles: %d vertices move (in patches, each affinely "
+                      "or as one piece, or as a sliver's corner), changed by %.2g at most",
                       u.turned_before - u.turned_after, u.turned_before, u.moved, u.largest_change);
         r.outcome.message += std::string(r.outcome.message.empty() ? "" : "; ") + what;
       }

@@ -8,7 +8,7 @@
 
 namespace afmb {
 
-Untangled untangle(const Eigen::MatrixXd &V0, const Eigen::MatrixXi &F, const std::vector<char> &fixed,
+Untangled untangle(const Eigen::MatrixXd &V0, const Eigen::MatrixXi &F, const std::vector<char> &hold,
                    const SimMesh *sim, Eigen::MatrixXd &D) {
   const bool lifted = sim && sim->decimated;
   std::vector<int> coarse, fine;  // the turned triangles of the last count
@@ -72,7 +72,7 @@ Untangled untangle(const Eigen::MatrixXd &V0, const Eigen::MatrixXi &F, const st
         corners_of(is_fine, f, c);
         for (int v : c) {
           member[static_cast<size_t>(v)] = 1;
-          if (!fixed.empty() && fixed[static_cast<size_t>(v)]) pinned[static_cast<size_t>(find(v))] = 1;
+          if (!hold.empty() && hold[static_cast<size_t>(v)] != kUntangleFree) pinned[static_cast<size_t>(find(v))] = 1;
           join(c[0], v);
         }
       }
@@ -82,7 +82,7 @@ Untangled untangle(const Eigen::MatrixXd &V0, const Eigen::MatrixXi &F, const st
     D = original;
     for (size_t r = 0; r < n; ++r) {
       const std::vector<int> &p = patches[r];
-      if (p.empty() || pinned[r]) continue;  // a patch holding a fixed vertex stays as solved
+      if (p.empty() || pinned[r]) continue;  // a patch holding a held or fixed vertex stays as solved
       // The affine motion nearest the solved one (least squares, the
       // minimum-norm one where the patch is flat), or one translation, the
       // mean, for a patch that turned inside.
@@ -105,6 +105,33 @@ Untangled untangle(const Eigen::MatrixXd &V0, const Eigen::MatrixXi &F, const st
     if (now < out.turned_after) out.turned_after = now, best = D;
   }
   D = std::move(best);
+  // The slivers still turned: an apex to its foot's motion (untangle.h),
+  // kept where fewer triangles turn, until no apex helps.
+  bool any = out.turned_after > 0;
+  while (any) {
+    any = false;
+    count(D);
+    const std::vector<int> faces = coarse;
+    for (int f : faces) {
+      int e = 0;  // the longest rest edge, e -> e + 1
+      double longest = -1;
+      for (int k = 0; k < 3; ++k)
+        if (const double l = (V0.row(F(f, (k + 1) % 3)) - V0.row(F(f, k))).squaredNorm(); l > longest)
+          longest = l, e = k;
+      const int a = F(f, e), b = F(f, (e + 1) % 3), apex = F(f, (e + 2) % 3);
+      if (!hold.empty() && hold[static_cast<size_t>(apex)] == kUntangleFixed) continue;
+      const Eigen::RowVector3d ab = V0.row(b) - V0.row(a);
+      const double t = std::clamp((V0.row(apex) - V0.row(a)).dot(ab) / longest, 0.0, 1.0);
+      const Eigen::RowVector3d foot = (1 - t) * D.row(a) + t * D.row(b);
+      if ((foot - D.row(apex)).squaredNorm() > kSliverShare * kSliverShare * longest) continue;
+      const Eigen::RowVector3d was = D.row(apex);
+      D.row(apex) = foot;
+      if (const int now = count(D); now < out.turned_after)
+        out.turned_after = now, any = true;
+      else
+        D.row(apex) = was;
+    }
+  }
   for (Eigen::Index v = 0; v < D.rows(); ++v) {
     out.moved += D.row(v) != original.row(v);
     out.largest_change = std::max(out.largest_change, (D.row(v) - original.row(v)).norm());

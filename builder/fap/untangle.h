@@ -15,17 +15,27 @@
 // triangle still turns moves as one piece instead (the mean of its
 // members' motion), which turns nothing inside. Triangles that turn then,
 // at a patch's edge, join it in the next round, until nothing turns or
-// kUntangleMaxRounds. A patch holding a vertex marked `fixed` (a FAP's own
-// FDP, which keeps the motion it was measured by; the synthesis marks the
-// skin held off an eyeball too) stays as solved, and what
-// turns in it stays turned, for the caller to report: the folds at the
-// lower lip's FDPs that the split of shared skin makes (fap_partition.h)
-// are such. Moved with the FDP, as one piece or as a harmonic blend, the
-// skin around the 10k head's lower lip FDP went 7 mm. The rest shape is
-// kept; only the motion within the patches changes. Where the solve tears
-// a corner apart (Song's mouth corner: the lower lip, carried by the jaw,
-// moves 1.6 mm from the upper one, which stays, within a millimetre) the
-// change is about half of that jump.
+// kUntangleMaxRounds. A patch holding a vertex marked held or fixed (a
+// FAP's own FDP, which keeps the motion it was measured by, is fixed; the
+// skin the solver holds off an eyeball is held) stays as solved: moved with
+// the FDP, as one piece or as a harmonic blend, the skin around the 10k
+// head's lower lip FDP went 7 mm, and a patch of Song's closing upper lid,
+// moved affinely, left a hole in it. The rest shape is kept; only the motion
+// within the patches changes. Where the solve tears a corner apart (Song's
+// mouth corner: the lower lip, carried by the jaw, moves 1.6 mm from the
+// upper one, which stays, within a millimetre) the change is about half of
+// that jump.
+//
+// Then the slivers still turned, one vertex each: the corner opposite a
+// turned triangle's longest rest edge (its apex) takes the motion of its
+// foot on that edge, so that it keeps its rest place beside the edge, when
+// that changes it by at most kSliverShare of the edge, it is not fixed (a
+// held one may move: Song's lids at their corners, 0.09-0.18 units, which
+// takes them further off the eyeball), and fewer triangles turn after. What
+// still turns stays turned, for the caller to report: the folds at the lower
+// lip's FDPs that the split of shared skin makes (fap_partition.h), where a
+// FAP alone carries its FDP past the other lip line's (Song's FAP 57 raises
+// 8.7 3.0 units, 1.3 units past 2.8, which FAP 10 moves).
 //
 // On a simulation mesh (`sim` decimated), what is stored is the lifted
 // skin (sim_mesh.h), so its turned triangles count too: each stands for
@@ -40,20 +50,28 @@
 namespace afmb {
 
 constexpr int kUntangleMaxRounds = 32;  // then it gives up, keeping the best round
+constexpr double kSliverShare = 0.25;    // the most a sliver's apex moves, of its longest edge
+
+// What untangle() may do with a vertex's motion.
+enum UntangleHold : char {
+  kUntangleFree = 0,   // anything
+  kUntangleHeld = 1,   // its patch stays as solved; as a sliver's apex it may move
+  kUntangleFixed = 2,  // nothing
+};
 
 struct Untangled {
   int turned_before = 0;  // turned triangles before (coarse plus lifted)
-  int turned_after = 0;   // after: 0 unless it gave up or a fixed vertex holds a fold
-  int moved = 0;          // vertices whose displacement changed (in the patches)
+  int turned_after = 0;   // after: 0 unless it gave up or a held or fixed vertex holds a fold
+  int moved = 0;          // vertices whose displacement changed (patches, apices)
   double largest_change = 0;  // the largest change of a vertex's displacement, model units
 };
 
 // Untangles D (#V x 3, model units: the displacement of the mesh V0 #V x 3,
-// F #F x 3) in place. `fixed`: #V flags, or empty. `sim`: the simulation
-// mesh whose coarse skin V0 is, or null. D is left as it was when nothing
+// F #F x 3) in place. `hold`: #V UntangleHold values, or empty (all free).
+// `sim`: the simulation mesh whose coarse skin V0 is, or null. D is left as it was when nothing
 // turns; when not everything untangles, D is the round with the fewest
 // turned triangles.
-Untangled untangle(const Eigen::MatrixXd &V0, const Eigen::MatrixXi &F, const std::vector<char> &fixed,
+Untangled untangle(const Eigen::MatrixXd &V0, const Eigen::MatrixXi &F, const std::vector<char> &hold,
                    const SimMesh *sim, Eigen::MatrixXd &D);
 
 }  // namespace afmb

@@ -56,6 +56,42 @@ fdps_on_parts "$tmp/coords.afm" >"$tmp/fdps_coords.txt"
 cmp -s "$tmp/fdps_xfaceed.txt" "$tmp/fdps_coords.txt" ||
   fail "Song's FDP coordinates land elsewhere: $(diff "$tmp/fdps_xfaceed.txt" "$tmp/fdps_coords.txt" | head -n 4)"
 
+# No target turns a skin triangle over (the report's `turned`), but a FAP
+# target whose prescription alone carries its FDP to within a quarter of the
+# way of where another FDP of its part rests ahead of it (within the
+# motion's length of its line): the skin between is squeezed to a quarter
+# and less, and where that FDP is another FAP's, the split of shared skin
+# between the inner and outer lip FAPs (builder/fap/fap_partition.h) folds it. On
+# Song those are the lower lip's middle lowered (FAP 5 negative: 2.3 3.03
+# units toward 8.2, 3.49 below it) and its outer line raised (57, 58: 8.7
+# 3.03 toward 2.8, 3.35 above). The lids' slivers turned before the
+# untangling moved their corners (19, 20).
+awk -F, 'NR > 1 { print "fap", $1, $8 }' "$AFM_SHARED_DIR/reference/mpeg4-fap-table.csv" >"$tmp/turned_in.txt"
+tr -d '()+' <"$tmp/fdps_xfaceed.txt" | awk '{ print "fdp", $1, $2, $3, $4, $5 }' >>"$tmp/turned_in.txt"
+sed 's/"[^"]*"//g' "$tmp/report/report.csv" |
+  awk -F, 'NR > 1 && $21 > 0 { print "turned", $1, $2, $4, $9, $10, $11, $21, $5 }' >>"$tmp/turned_in.txt"
+grep -q '^fdp 8\.7 ' "$tmp/turned_in.txt" || fail "Song: no FDP positions for the turned-triangle check"
+awk '$1 == "fap" { fdp[$2] = $3 }
+  $1 == "fdp" { part[$2] = $3; x[$2] = $4; y[$2] = $5; z[$2] = $6 }
+  $1 == "turned" {
+    why = ""
+    a = $2 == "fap" ? fdp[$3] : ""
+    m = sqrt($5 * $5 + $6 * $6 + $7 * $7)
+    if (a in x && m > 0)
+      for (b in x) {
+        if (b == a || part[b] != part[a]) continue
+        dx = x[b] - x[a]; dy = y[b] - y[a]; dz = z[b] - z[a]
+        ahead = (dx * $5 + dy * $6 + dz * $7) / m
+        across = dx * dx + dy * dy + dz * dz - ahead * ahead
+        if (ahead > 0 && 4 * (m - ahead) <= ahead && 4 * (ahead - m) <= ahead && across < m * m)
+          why = sprintf("carries %s %.3g units toward %s, %.3g ahead", a, m, b, ahead)
+      }
+    printf "%s %s %s at %s: %d triangles turned%s\n", why == "" ? "FAIL" : "allowed", $2, $3, $9, $8,
+      why == "" ? "" : " (" why ")"
+  }' "$tmp/turned_in.txt" >"$tmp/turned.txt"
+grep -q '^FAIL' "$tmp/turned.txt" && fail "Song: targets turn skin triangles over: $(grep '^FAIL' "$tmp/turned.txt")"
+[ -s "$tmp/turned.txt" ] && echo "Song: $(tr '\n' ';' <"$tmp/turned.txt")"
+
 "$bin/afm-play" "$tmp/song.afm" "$stream" >"$tmp/play.txt" 2>&1 || fail "afm-play failed on Song: $(tail -n 3 "$tmp/play.txt")"
 # A line per frame with its pose hash: the face must move, so the hashes vary.
 hashes=$(awk '$1 == "frame" { print $NF }' "$tmp/play.txt" | sort -u | wc -l)

@@ -1038,7 +1038,7 @@ TEST(Untangle, APatchTurnsNoTriangleAndOneHoldingAFixedVertexStaysAsSolved) {
   EXPECT_EQ(kept, k * k - u.moved);
   // The middle fixed: its patch stays as solved, and says what still turns.
   std::vector<char> fixed(static_cast<size_t>(k * k), 0);
-  fixed[static_cast<size_t>(mid)] = 1;
+  fixed[static_cast<size_t>(mid)] = kUntangleFixed;
   E = D;
   const Untangled y = untangle(V, F, fixed, nullptr, E);
   EXPECT_EQ(E, D);
@@ -1046,7 +1046,7 @@ TEST(Untangle, APatchTurnsNoTriangleAndOneHoldingAFixedVertexStaysAsSolved) {
   EXPECT_EQ(y.turned_after, y.turned_before);
   // A fixed vertex away from the fold does not hold it.
   std::fill(fixed.begin(), fixed.end(), 0);
-  fixed[0] = 1;
+  fixed[0] = kUntangleFixed;
   E = D;
   EXPECT_EQ(untangle(V, F, fixed, nullptr, E).turned_after, 0);
   EXPECT_EQ(E.row(0), D.row(0));
@@ -1059,6 +1059,49 @@ TEST(Untangle, APatchTurnsNoTriangleAndOneHoldingAFixedVertexStaysAsSolved) {
   EXPECT_EQ(x.turned_before, 0);
   EXPECT_EQ(x.moved, 0);
   EXPECT_EQ(G, G0);
+}
+
+// untangle()'s last step (untangle.h): a sliver whose apex a held vertex
+// is, carried just across its longest edge, untangles by that apex taking
+// its foot's motion, and nothing else changes; a fixed apex, or one that
+// would move more than kSliverShare of the edge, stays, and the sliver
+// stays turned.
+TEST(Untangle, AHeldSliversApexTakesItsFootsMotionAndAFixedOneStays) {
+  Eigen::MatrixXd V(5, 3);
+  V << 0, 0, 0,  // a
+      2, 0, 0,   // b
+      1, 0.05, 0,  // c: the apex, 0.05 above ab
+      1, 1, 0,   // d
+      1, -1, 0;  // e
+  Eigen::MatrixXi F(4, 3);
+  F << 0, 1, 2, 0, 2, 3, 2, 1, 3, 0, 4, 1;
+  ASSERT_TRUE(turned_faces(V, F, V).empty());
+  Eigen::MatrixXd D = Eigen::MatrixXd::Zero(5, 3);
+  D.col(0).setConstant(0.3);  // everything slides along x
+  D(2, 1) = -0.1;             // and the apex passes ab
+  ASSERT_EQ(turned_faces(V, F, V + D), std::vector<int>{0});
+  std::vector<char> hold(5, kUntangleHeld);
+  Eigen::MatrixXd E = D;
+  const Untangled u = untangle(V, F, hold, nullptr, E);
+  EXPECT_EQ(u.turned_before, 1);
+  EXPECT_EQ(u.turned_after, 0);
+  EXPECT_EQ(u.moved, 1);
+  EXPECT_NEAR(u.largest_change, 0.1, 1e-12);
+  EXPECT_TRUE(E.row(2).isApprox(D.row(0))) << "the apex moves as its foot, the middle of ab";
+  EXPECT_EQ(E.topRows(2), D.topRows(2));
+  EXPECT_EQ(E.bottomRows(2), D.bottomRows(2));
+  // Fixed: it stays, and so does the fold.
+  hold[2] = kUntangleFixed;
+  E = D;
+  EXPECT_EQ(untangle(V, F, hold, nullptr, E).turned_after, 1);
+  EXPECT_EQ(E, D);
+  // Carried further than a quarter of ab (0.5): it stays too.
+  hold[2] = kUntangleHeld;
+  D(2, 1) = -0.6;
+  ASSERT_EQ(turned_faces(V, F, V + D), std::vector<int>{0});
+  E = D;
+  EXPECT_EQ(untangle(V, F, hold, nullptr, E).turned_after, 1);
+  EXPECT_EQ(E, D);
 }
 
 // Groups too weak within their calibrated range pass it (their tensions
