@@ -1311,6 +1311,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         r.outcome.message += std::string(r.outcome.message.empty() ? "" : "; ") + what;
       }
       r.outcome.turned = static_cast<int>(turned_faces(rest, skin.F, rest + D).size());
+      r.outcome.sunk = static_cast<int>(skin_faults(model, rest + D).sunk_vertices.size());
       out.targets.push_back(std::move(t));
     }
     if (r.control) out.jaw.controls.push_back(*r.control);

@@ -160,6 +160,9 @@ struct FapOutcome {
                                   // whole: its turn, radians; jaw FAPs: percent / 100
   int turned = 0;                 // skin triangles the target turns over (turned_faces), on
                                   // the input's skin once lifted (lift_synthesis)
+  int sunk = 0;                   // skull-tied skin vertices the target takes more than an
+                                  // AFM quantum below their skull node's rest plane
+                                  // (skin_faults), on the simulated skin
   int dynamic = 0;                // vertices solved
   bool mirrored = false;          // made from its left twin's recipe ("Mirror twins" above)
   double seconds = 0;

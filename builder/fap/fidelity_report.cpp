@@ -114,7 +114,7 @@ std::string fidelity_table(const FapSynthesis &s) {
   std::string out = format("%-4s %-34s %6s %8s %10s %10s %8s %8s %7s %6s\n", "fap", "name", "ref", "scale",
                            "prescribed", "achieved", "along", "off-axis", "V_d", "turned");
   std::vector<double> along, off, off_face, off_depth, reach;
-  int failed = 0, turning = 0, turned = 0, kinematic = 0;
+  int failed = 0, turning = 0, turned = 0, sinking = 0, kinematic = 0;
   for (const FapOutcome &o : s.outcomes) {
     const std::string id = target_id(o);
     const std::string name = target_label(o);
@@ -126,6 +126,7 @@ std::string fidelity_table(const FapSynthesis &s) {
       continue;
     }
     if (o.turned > 0) ++turning, turned += o.turned;
+    if (o.sunk > 0) ++sinking;
     if (o.kind != AFM_TARGET_FAP) {
       out += format("%-4s %-34s %6d %8s %10s %10.4g %8s %8s %7d %6d%s%s\n", id.c_str(), name.c_str(), o.reference,
                     "-", "-", o.largest, "-", "-", o.dynamic, o.turned, o.message.empty() ? "" : "  ",
@@ -153,10 +154,11 @@ std::string fidelity_table(const FapSynthesis &s) {
   out += format("targets: %zu made, %d not made; FAPs along the direction median %.2f%% worst %.2f%%; off-axis "
                 "median %.1f%% worst %.1f%% (across the face median %.1f%%, in depth %.1f%%); %zu under-reach "
                 "(median %.0f%% of the prescribed motion); %d turn %d skin triangles over (visemes and "
-                "expressions: achieved = largest motion)%s\n",
+                "expressions: achieved = largest motion)%s%s\n",
                 s.targets.size(), failed, 100 * median(along), 100 * worst(along), 100 * median(off),
                 100 * worst(off), 100 * median(off_face), 100 * median(off_depth), reach.size(),
                 100 * median(reach), turning, turned,
+                sinking ? format("; %d sink skin below the skull", sinking).c_str() : "",
                 kinematic ? format("; %d targets of the tongue and pupils are exact by construction and not in "
                                    "these figures",
                                    kinematic)
@@ -178,14 +180,14 @@ Status write_fidelity_report(const std::string &dir, const Scene &scene, const F
   if (Status st = write_file_atomic(dir + sep + "report.txt", table); !st) return st;
   std::string csv =
       "kind,number,name,side,reference,reached,made,scale,prescribed_x,prescribed_y,prescribed_z,achieved_x,"
-      "achieved_y,achieved_z,along_error,off_axis,off_face,off_depth,largest,dynamic,turned,seconds,message\n";
+      "achieved_y,achieved_z,along_error,off_axis,off_face,off_depth,largest,dynamic,turned,sunk,seconds,message\n";
   for (const FapOutcome &o : s.outcomes)
-    csv += format("%s,%d,%s,%d,%d,%.4g,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%.3f,",
+    csv += format("%s,%d,%s,%d,%d,%.4g,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%d,%.3f,",
                   o.kind == AFM_TARGET_FAP ? "fap" : o.kind == AFM_TARGET_VISEME ? "viseme" : "expression",
                   o.number, csv_quote(target_label(o)).c_str(), o.side, o.reference, o.reached, o.made ? 1 : 0,
                   o.scale, o.prescribed.x(), o.prescribed.y(), o.prescribed.z(), o.achieved.x(), o.achieved.y(),
                   o.achieved.z(), o.along_error, o.off_axis, o.off_face, o.off_depth, o.largest, o.dynamic,
-                  o.turned, o.seconds) +
+                  o.turned, o.sunk, o.seconds) +
            csv_quote(o.message) + "\n";
   if (Status st = write_file_atomic(dir + sep + "report.csv", csv); !st) return st;
 

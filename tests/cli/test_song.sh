@@ -91,6 +91,12 @@ awk '$1 == "fap" { fdp[$2] = $3 }
   }' "$tmp/turned_in.txt" >"$tmp/turned.txt"
 grep -q '^FAIL' "$tmp/turned.txt" && fail "Song: targets turn skin triangles over: $(grep '^FAIL' "$tmp/turned.txt")"
 [ -s "$tmp/turned.txt" ] && echo "Song: $(tr '\n' ';' <"$tmp/turned.txt")"
+# Nor sinks skin below the skull (the report's `sunk`: skull-tied vertices
+# more than an AFM quantum below their skull node's rest plane).
+sed 's/"[^"]*"//g' "$tmp/report/report.csv" |
+  awk -F, 'NR == 1 && $22 != "sunk" { print "no sunk column: " $0 } NR > 1 && $22 != 0 { print $1, $2, "at", $5 ":", $22 }' \
+    >"$tmp/sunk.txt"
+[ -s "$tmp/sunk.txt" ] && fail "Song: targets sink skin below the skull: $(tr '\n' ';' <"$tmp/sunk.txt")"
 
 "$bin/afm-play" "$tmp/song.afm" "$stream" >"$tmp/play.txt" 2>&1 || fail "afm-play failed on Song: $(tail -n 3 "$tmp/play.txt")"
 # A line per frame with its pose hash: the face must move, so the hashes vary.
