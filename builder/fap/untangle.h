@@ -34,8 +34,9 @@
 // takes them further off the eyeball), and fewer triangles turn after. What
 // still turns stays turned, for the caller to report: the folds at the lower
 // lip's FDPs that the split of shared skin makes (fap_partition.h), where a
-// FAP alone carries its FDP past the other lip line's (Song's FAP 57 raises
-// 8.7 3.0 units, 1.3 units past 2.8, which FAP 10 moves).
+// FAP alone carries its FDP most of the way to the other lip line's (Song's
+// FAP 57 raises 8.7 3.03 units toward 2.8, which rests 3.35 above it and
+// stays).
 //
 // On a simulation mesh (`sim` decimated), what is stored is the lifted
 // skin (sim_mesh.h), so its turned triangles count too: each stands for
