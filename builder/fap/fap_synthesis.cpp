@@ -1303,15 +1303,16 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       if (u.moved > 0) {
         for (const SkinBinding &b : carried) t.displacement[static_cast<size_t>(b.part)] = Eigen::MatrixXd();
         carry(D, t);
-        char what[160];
+        char what[224];
         std::snprintf(what, sizeof what,
                       "untangled %d of %d turned triangles: %d vertices move (in patches, each affinely "
                       "or as one piece, or as a sliver's corner), changed by %.2g at most",
                       u.turned_before - u.turned_after, u.turned_before, u.moved, u.largest_change);
         r.outcome.message += std::string(r.outcome.message.empty() ? "" : "; ") + what;
       }
-      r.outcome.turned = static_cast<int>(turned_faces(rest, skin.F, rest + D).size());
-      r.outcome.sunk = static_cast<int>(skin_faults(model, rest + D).sunk_vertices.size());
+      const SkinFaults faults = skin_faults(model, rest + D);
+      r.outcome.turned = static_cast<int>(faults.turned_faces.size());
+      r.outcome.sunk = static_cast<int>(faults.sunk_vertices.size());
       out.targets.push_back(std::move(t));
     }
     if (r.control) out.jaw.controls.push_back(*r.control);
