@@ -204,7 +204,8 @@ struct FapSynthesisOptions {
 // twin (made and dropped: see "Mirror twins"), with every right muscle's
 // left twin (face_model.h: it calibrates from it); the jaw for the jaw FAPs and a
 // viseme or expression that opens it. Each muscle calibrates on its own, so
-// the targets are the same as on a model with every muscle calibrated.
+// the poses are the same as on a model with every muscle calibrated (the
+// targets split shared skin only among those made: fap_partition.h).
 // Nothing listed: every muscle and the jaw (`all`).
 struct CalibrationNeeds {
   bool all = true;

@@ -93,7 +93,10 @@ void usage(FILE *out) {
       "                          expressions, e.g. 3,12,31,v1,e1 (default: every mapped one);\n"
       "                          calibrates only the muscles they use (and those of\n"
       "                          --contract and --influence), and the jaw when one opens\n"
-      "                          it or --jaw does: the targets are the same\n"
+      "                          it or --jaw does: the poses are the same; FAPs made\n"
+      "                          together split the skin they share, so a FAP listed\n"
+      "                          without its partners keeps their share (FAP 12 without\n"
+      "                          59 raises the lip corner all the way)\n"
       "  --no-steer              each FAP's muscle group acts alone: no helper muscles\n"
       "                          steer its FDP back onto the FAP's direction\n"
       "                          (--list-faps names each FAP's helpers)\n"
@@ -315,7 +318,7 @@ int main(int argc, char **argv) {
   if (!report_dir.empty() && out_path.empty()) return usage_error("--report needs -o");
 
   // A subset of targets calibrates only what it poses (each muscle
-  // calibrates on its own: the targets are the same).
+  // calibrates on its own: the poses are the same).
   if (const CalibrationNeeds need = calibration_needs(so); !need.all && fo.calibrate) {
     fo.calibrate_only = need.muscles;
     for (const auto &c : contractions) fo.calibrate_only.push_back(c.first);
