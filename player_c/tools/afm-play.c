@@ -34,6 +34,7 @@ static void usage(FILE *out) {
           "                   recomputing normals\n"
           "  --fdp-motion     after playing, each FDP group's motion against the stream's\n"
           "                   MPEG-4 prescription (see below)\n"
+          "  --folds          count the skin triangles each frame turns over (see below)\n"
           "  --quiet          no per-frame lines, only the summary\n"
           "  --help           this text\n"
           "\n"
@@ -49,6 +50,13 @@ static void usage(FILE *out) {
           "(100 %% is exact; above it, the face overshoots the stream). Motion that no\n"
           "FAP of an FDP prescribes counts as played: the jaw's opening (FAP 3 names\n"
           "only the chin, 2.1) moves the lower lip's FDPs too.\n"
+          "\n"
+          "--folds: in every frame, the skin's triangles (parts of kind skin) whose\n"
+          "normal points against their rest normal, the head's rotation left out;\n"
+          "slivers under a thousandth of the skin's mean rest area are not counted, as\n"
+          "in afm-build's report. Each frame line gets 'turned N' before its hash, and\n"
+          "the summary says how many frames turn any, and the most one frame turns,\n"
+          "with that frame's nonzero FAP values.\n"
           "\n"
           "Exit status: 0 on success, 1 on bad input (the message names the file and\n"
           "line or field), 2 on bad usage.\n");
@@ -257,10 +265,116 @@ static int compare_double(const void *a, const void *b) {
   return x < y ? -1 : x > y;
 }
 
+/* --folds (see usage): the skin triangles counted and their rest normals. */
+typedef struct folds {
+  uint32_t *triangle;      /* indices into geometry.triangles */
+  double *normal;          /* [3 x count] rest normals, model units squared */
+  uint32_t count;          /* skin triangles counted (slivers left out) */
+  uint32_t frames;         /* frames turning any */
+  uint32_t most, most_frame; /* the most one frame turns, and that frame */
+  afm_fap_state most_state; /* the values there */
+} folds;
+
+static void triangle_normal(const afm_geometry *g, const int32_t *x, uint32_t tri, double n[3]) {
+  double p[3][3], u[3], v[3];
+  int c, k;
+  for (c = 0; c < 3; ++c) {
+    const uint32_t i = g->triangles[3 * tri + (uint32_t)c];
+    for (k = 0; k < 3; ++k)
+      p[c][k] = x ? (double)x[3 * i + (uint32_t)k] : (double)(k == 0 ? g->px[i] : k == 1 ? g->py[i] : g->pz[i]);
+  }
+  for (k = 0; k < 3; ++k) u[k] = p[1][k] - p[0][k], v[k] = p[2][k] - p[0][k];
+  n[0] = u[1] * v[2] - u[2] * v[1];
+  n[1] = u[2] * v[0] - u[0] * v[2];
+  n[2] = u[0] * v[1] - u[1] * v[0];
+}
+
+/* The skin's triangles with their rest normals (in quanta: only the sign of
+ * a dot product is used), slivers under a thousandth of the mean left out. */
+static int folds_init(folds *fo, const afm_doc *doc) {
+  const afm_geometry *g = &doc->geometry;
+  uint32_t part, tri, total = 0;
+  double sum = 0, n[3];
+  memset(fo, 0, sizeof *fo);
+  for (part = 0; part < g->part_count; ++part)
+    if (g->parts[part].kind == AFM_PART_SKIN) total += g->parts[part].triangle_count;
+  fo->triangle = (uint32_t *)malloc((total ? total : 1) * sizeof *fo->triangle);
+  fo->normal = (double *)malloc((total ? total : 1) * 3 * sizeof *fo->normal);
+  if (!fo->triangle || !fo->normal) return 0;
+  for (part = 0; part < g->part_count; ++part) {
+    const afm_part *a = &g->parts[part];
+    if (a->kind != AFM_PART_SKIN) continue;
+    for (tri = a->first_triangle; tri < a->first_triangle + a->triangle_count; ++tri) {
+      triangle_normal(g, NULL, tri, n);
+      sum += sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    }
+  }
+  for (part = 0; part < g->part_count; ++part) {
+    const afm_part *a = &g->parts[part];
+    if (a->kind != AFM_PART_SKIN) continue;
+    for (tri = a->first_triangle; tri < a->first_triangle + a->triangle_count; ++tri) {
+      triangle_normal(g, NULL, tri, n);
+      if (!(sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) > 1e-3 * sum / total)) continue;
+      fo->triangle[fo->count] = tri;
+      memcpy(fo->normal + 3 * fo->count, n, sizeof n);
+      ++fo->count;
+    }
+  }
+  return 1;
+}
+
+static void folds_free(folds *fo) {
+  free(fo->triangle);
+  free(fo->normal);
+}
+
+/* Frame `frame`'s pose (positions without the head's motion, values a and b
+ * blended by t): the count of turned triangles, also kept in the summary. */
+static uint32_t folds_add(folds *fo, const afm_doc *doc, const afm_player *p, uint32_t frame,
+                          const afm_fap_state *a, const afm_fap_state *b, afm_q16 t) {
+  const int32_t *x = afm_player_positions(p);
+  uint32_t i, turned = 0, f;
+  double n[3];
+  for (i = 0; i < fo->count; ++i) {
+    const double *n0 = fo->normal + 3 * i;
+    triangle_normal(&doc->geometry, x, fo->triangle[i], n);
+    turned += n0[0] * n[0] + n0[1] * n[1] + n0[2] * n[2] <= 0;
+  }
+  if (turned) ++fo->frames;
+  if (turned > fo->most) {
+    fo->most = turned;
+    fo->most_frame = frame;
+    fo->most_state = *a;
+    for (f = 0; f <= AFM_FAP_COUNT; ++f)
+      fo->most_state.value[f] = a->value[f] + (int32_t)(((int64_t)(b->value[f] - a->value[f]) * t) / 65536);
+  }
+  return turned;
+}
+
+static void folds_print(const folds *fo, uint32_t frames) {
+  uint32_t f;
+  printf("turned skin triangles: %lu of %lu frames turn any", (unsigned long)fo->frames, (unsigned long)frames);
+  if (!fo->most) {
+    printf(" (%lu triangles counted)\n", (unsigned long)fo->count);
+    return;
+  }
+  printf("; most %lu (of %lu counted) at frame %lu, where the FAPs are:", (unsigned long)fo->most,
+         (unsigned long)fo->count, (unsigned long)fo->most_frame);
+  for (f = 1; f <= AFM_FAP_COUNT; ++f)
+    if (fo->most_state.value[f]) printf(" %lu=%ld", (unsigned long)f, (long)fo->most_state.value[f]);
+  if (fo->most_state.viseme.select1 || fo->most_state.viseme.select2)
+    printf(" viseme %u/%u blend %u", fo->most_state.viseme.select1, fo->most_state.viseme.select2,
+           fo->most_state.viseme.blend);
+  if (fo->most_state.expression.select1 || fo->most_state.expression.select2)
+    printf(" expression %u at %u, %u at %u", fo->most_state.expression.select1, fo->most_state.expression.intensity1,
+           fo->most_state.expression.select2, fo->most_state.expression.intensity2);
+  printf("\n");
+}
+
 int main(int argc, char **argv) {
   const char *model_path = NULL, *stream_path = NULL, *obj_dir = NULL;
   unsigned long fps = 0;
-  int stats = 0, quiet = 0, motion = 0, i;
+  int stats = 0, quiet = 0, motion = 0, folding = 0, i;
   uint32_t mirror = 0, frame_count = 0, rendered = 0, k;
   afm_player_options po;
   uint8_t *model_data = NULL, *stream_data = NULL;
@@ -273,6 +387,7 @@ int main(int argc, char **argv) {
   afm_player *player = NULL, *still = NULL;
   void *player_memory = NULL, *still_memory = NULL;
   fdp_motion fm;
+  folds fo;
   double *times = NULL;
   afm_diag diag;
   afm_read_options ro;
@@ -308,6 +423,8 @@ int main(int argc, char **argv) {
       stats = 1;
     } else if (!strcmp(a, "--fdp-motion")) {
       motion = 1;
+    } else if (!strcmp(a, "--folds")) {
+      folding = 1;
     } else if (!strcmp(a, "--quiet")) {
       quiet = 1;
     } else if (!strcmp(a, "--normal-deltas")) {
@@ -330,6 +447,7 @@ int main(int argc, char **argv) {
   }
 
   memset(&fm, 0, sizeof fm);
+  memset(&fo, 0, sizeof fo);
   memset(&diag, 0, sizeof diag);
   if (afm_file_read(model_path, NULL, &model_data, &model_size) != AFM_OK) {
     fprintf(stderr, "afm-play: %s: cannot read: %s\n", model_path, strerror(errno));
@@ -374,9 +492,9 @@ int main(int argc, char **argv) {
     if (!player_memory) r = AFM_ERR_OUT_OF_MEMORY;
   }
   if (r == AFM_OK) r = afm_player_init(doc, &po, player_memory, player_bytes, &player);
-  if (r == AFM_OK && motion) {
-    /* The FDPs' motion is measured in the head's frame: a second player
-       that leaves the head's rigid motion out. */
+  if (r == AFM_OK && (motion || folding)) {
+    /* The FDPs' motion and the folds are measured in the head's frame: a
+       second player that leaves the head's rigid motion out. */
     afm_player_options head = po;
     size_t bytes = 0;
     head.flags |= AFM_PLAYER_HEAD_MATRIX;
@@ -404,7 +522,7 @@ int main(int argc, char **argv) {
     /* Render times: the stream's own frames, or a resampled clock. */
     uint32_t total = fps ? (uint32_t)(duration_us * fps / 1000000u) + 1 : frame_count;
     times = (double *)malloc(total * sizeof *times);
-    if (!times || (motion && !fdp_motion_init(&fm, doc, total))) {
+    if (!times || (motion && !fdp_motion_init(&fm, doc, total)) || (folding && !folds_init(&fo, doc))) {
       fprintf(stderr, "afm-play: out of memory\n");
       goto done;
     }
@@ -412,6 +530,7 @@ int main(int argc, char **argv) {
       const afm_fap_state *a, *b;
       afm_q16 t;
       const afm_pose_info *info;
+      uint32_t turned = 0;
       double t0;
       t_us = fps ? (uint64_t)k * 1000000u / fps : 0;
       if (!fps) {
@@ -427,19 +546,22 @@ int main(int argc, char **argv) {
         goto done;
       }
       info = afm_player_info(player);
-      if (!quiet)
-        printf("frame %5lu  t %8.3f s  targets %3lu  updates %7lu  hash %016llx\n", (unsigned long)k,
-               (double)t_us * 1e-6, (unsigned long)info->active_targets, (unsigned long)info->updates,
-               (unsigned long long)pose_hash(player, doc->geometry.vertex_count));
-      if (obj_dir && !write_obj(obj_dir, k, doc, player)) goto done;
       if (still) {
         r = afm_player_pose(still, a, b, t);
         if (r != AFM_OK) {
           fprintf(stderr, "afm-play: frame %lu: %s\n", (unsigned long)k, afm_result_string(r));
           goto done;
         }
-        fdp_motion_add(&fm, doc, still, a, b, t);
+        if (motion) fdp_motion_add(&fm, doc, still, a, b, t);
+        if (folding) turned = folds_add(&fo, doc, still, k, a, b, t);
       }
+      if (!quiet) {
+        printf("frame %5lu  t %8.3f s  targets %3lu  updates %7lu  ", (unsigned long)k, (double)t_us * 1e-6,
+               (unsigned long)info->active_targets, (unsigned long)info->updates);
+        if (folding) printf("turned %4lu  ", (unsigned long)turned);
+        printf("hash %016llx\n", (unsigned long long)pose_hash(player, doc->geometry.vertex_count));
+      }
+      if (obj_dir && !write_obj(obj_dir, k, doc, player)) goto done;
       ++rendered;
     }
   }
@@ -459,9 +581,11 @@ int main(int argc, char **argv) {
            (unsigned long)fap_stats.rounded);
   }
   if (motion) fdp_motion_print(&fm);
+  if (folding) folds_print(&fo, rendered);
   status = 0;
 done:
   fdp_motion_free(&fm);
+  folds_free(&fo);
   free(times);
   free(still_memory);
   free(player_memory);
