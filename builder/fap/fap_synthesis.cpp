@@ -221,6 +221,12 @@ int fdp_vertex(const FaceModel &model, const afm_fap_info *info) {
   return p && p->part == model.skin && p->vertex >= 0 ? p->vertex : -1;
 }
 
+// The lip corners, inner (2.4, 2.5) and outer (8.3, 8.4).
+bool lip_corner_fdp(const afm_fap_info *info) {
+  return (info->fdp_group == 2 && (info->fdp_index == 4 || info->fdp_index == 5)) ||
+         (info->fdp_group == 8 && (info->fdp_index == 3 || info->fdp_index == 4));
+}
+
 void measure(FapOutcome &o, const Eigen::Vector3d &achieved, const Eigen::Vector3d &dir) {
   o.achieved = achieved;
   const double len = o.prescribed.norm();
@@ -1225,6 +1231,22 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     o.made = false;
     o.message += "; not kept: not past the side's target at " + std::to_string(nearer);
   }
+  // The mouth corner moves as one (the modiolus: "The modiolus" in
+  // fap_synthesis.h).
+  for (size_t k = 0; k < work.size(); ++k) {
+    const FapMapping *f = work[k].fap;
+    if (!f || f->driver != FapDriver::Muscles || !results[k].target) continue;
+    const afm_fap_info *info = afm_fap(f->fap);
+    if (!lip_corner_fdp(info)) continue;
+    const int c = fdp_vertex(model, info);
+    if (c < 0) continue;
+    MorphTarget &t = *results[k].target;
+    Eigen::MatrixXd &D = t.displacement[static_cast<size_t>(model.skin)];
+    if (D.rows() != skin.n) continue;
+    move_modiolus(skin.X0.topRows(skin.n), c, kModiolusRadius * model.fapu.mw0, D);
+    for (const SkinBinding &b : carried) t.displacement[static_cast<size_t>(b.part)] = Eigen::MatrixXd();
+    carry(D, t);
+  }
   // FAP targets that move the same skin split it (fap_partition.h).
   {
     std::vector<SharingTarget> sharing(work.size());
@@ -1322,6 +1344,17 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
   if (out.jaw.controls.empty()) out.jaw.parts.clear();
   if (options.sim) lift_synthesis(out, *options.sim);
   return out;
+}
+
+void move_modiolus(const Eigen::MatrixXd &V0, int corner, double radius, Eigen::MatrixXd &D) {
+  if (!(radius > 0) || corner < 0 || corner >= D.rows()) return;
+  const Eigen::RowVector3d c = V0.row(corner), dc = D.row(corner);
+  for (Eigen::Index v = 0; v < D.rows(); ++v) {
+    const double t2 = (V0.row(v) - c).squaredNorm() / (radius * radius);
+    if (t2 >= 1) continue;
+    const double w = (1 - t2) * (1 - t2);
+    D.row(v) += w * (dc - D.row(v));
+  }
 }
 
 void lift_synthesis(FapSynthesis &synthesis, const SimMesh &sim) {

@@ -37,8 +37,10 @@
 // On a simulation mesh the tarsus is held further off the eyeball by what
 // the lifted skin over it sinks below its clearance, in one more solve.
 //
-// FAP targets that move the same skin (the inner and outer lip FAPs, the
-// midlip and mid-left/right ones, the brows, ...) then split it between
+// A lip corner's FAP moves the skin around the corner with it ("The
+// modiolus" below). FAP targets that move the same skin (the inner and
+// outer lip FAPs, the midlip and mid-left/right ones, the brows, ...) then
+// split it between
 // them (fap_partition.h), so that a stream sending them together moves each
 // FDP once; the outcomes are measured on the split targets.
 //
@@ -232,6 +234,29 @@ struct FapSynthesis {
 // outcome with made = false.
 Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &model,
                                        const FapSynthesisOptions &options = {});
+
+// The modiolus. A FAP whose FDP is a lip corner (2.4, 2.5, 8.3, 8.4: FAPs
+// 6, 7, 12, 13, 53, 54, 59, 60) moves the skin within kModiolusRadius x MW0
+// of that corner with it, as the modiolus, the knot of fibres where the lip
+// and cheek muscles meet beside the corner, carries it: before the split of
+// shared skin, each vertex there takes a blend of its solved motion and the
+// corner's, the corner's weight (1 - (r / R)^2)^2 at rest distance r (1 at
+// the corner, 0 and flat at R). Why: Song's corner is a fan of slivers a
+// tenth of a unit wide, and the solve moves the skin around it unevenly
+// (raised, a neighbour 0.3 units off goes 0.14 units further out than the
+// corner; lowered, the corner goes 1.30 units and a vertex 0.9 away 0.79,
+// with 1.3-unit motions over slivers 0.1 wide): the corner's
+// whole pose turned 7 triangles, and the inner and outer corner FAPs sent
+// together, as streams send them, turned 4-5 at each corner (joy.fap: some
+// in 94 of its 108 frames). With R = 0.13 MW0 (3.3 units on Song, 6.6 mm on
+// the generated heads) none turn; at 0.1 one did, lowered, where the blend
+// ends. The FDP's own motion, which the report measures, is unchanged.
+constexpr double kModiolusRadius = 0.13;
+
+// Blends D (#V x 3, model units: the displacement of V0, #V x 3) toward
+// the motion of vertex `corner` within `radius` (model units) of it at rest,
+// as above. Nothing changes for radius <= 0 or a corner out of range.
+void move_modiolus(const Eigen::MatrixXd &V0, int corner, double radius, Eigen::MatrixXd &D);
 
 // Carries a synthesis made on a simulation mesh (sim_mesh.h: the model built
 // on sim_scene) to the skin. synthesize_faps does it when given the mesh

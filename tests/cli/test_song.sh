@@ -112,9 +112,7 @@ hashes=$(awk '$1 == "frame" { print $NF }' "$tmp/play.txt" | sort -u | wc -l)
 # under a thousandth of the mean rest area left out). Frame 1 sends joy.fap's
 # frame 75 (the corners raised, the lower lip lowered; the head still),
 # frame 2 the same three times over, which a face extrapolated that far
-# folds: the check has something to see. Streams played on Song still fold
-# at the lip corners (docs/notes.md, "Forty-third session"); the figures are
-# printed, not yet held to zero.
+# folds: the check has something to see.
 skin=$("$bin/afm-info" "$tmp/song.afm" | awk '/^  part  / { t = 1; next } t && $2 == "skin" { print $1; exit }')
 [ -n "$skin" ] || fail "Song: afm-info names no skin part"
 {
@@ -159,11 +157,38 @@ for k in 1 2; do
   [ "$k" = 2 ] && [ "${AFM_CONFIG:-release}" != sanitize ] && [ "${counted:-0}" -eq 0 ] &&
     fail "Song: joy's frame 75 at three times its values turns no skin triangle: the fold check sees nothing"
 done
+# Streams raise or stretch the inner and outer lip corners together (FAPs
+# 12 with 59, 6 with 53, ...): before the modiolus
+# (builder/fap/fap_synthesis.h) moved the skin around the corner with it,
+# 12 + 59 turned 4 triangles at each of Song's corners and joy.fap turned
+# some in 94 of its 108 frames. Now neither the pairs at their references
+# (frames 1-8) nor joy.fap turns any.
+faps="6 7 12 13 53 54 59 60"
+{
+  echo "2.1 corners 25 9"
+  for k in 0 1 2 3 4 5 6 7 8; do
+    awk 'BEGIN { for (f = 1; f <= 68; ++f) printf "%s%d", (f > 1 ? " " : ""), (f == 6 || f == 7 || f == 12 || f == 13 || f == 53 || f == 54 || f == 59 || f == 60); printf "\n" }'
+    awk -v k="$k" -v faps="$faps" 'BEGIN {
+      n = split(faps, f, " ")
+      split("0 12:150,59:150 12:-150,59:-150 13:150,60:150 13:-150,60:-150 6:70,53:70 6:-70,53:-70 7:70,54:70 7:-70,54:-70", rows, " ")
+      m = split(rows[k + 1], pairs, ",")
+      for (i = 1; i <= m; ++i) { split(pairs[i], q, ":"); v[q[1]] = q[2] }
+      printf "%d", k
+      for (i = 1; i <= n; ++i) printf " %d", v[f[i]]
+      printf "\n" }'
+  done
+} >"$tmp/corners.fap"
+"$bin/afm-play" "$tmp/song.afm" "$tmp/corners.fap" --quiet --folds >"$tmp/folds_corners.txt" 2>&1 ||
+  fail "afm-play --folds failed on Song's corners: $(tail -n 3 "$tmp/folds_corners.txt")"
+grep -q '^turned skin triangles: 0 of 9 frames' "$tmp/folds_corners.txt" ||
+  fail "Song: the lip corners' FAPs sent in pairs turn skin triangles: $(cat "$tmp/folds_corners.txt")"
 for f in joy anger fear; do
   "$bin/afm-play" "$tmp/song.afm" "$AFM_SHARED_DIR/data/fap/xface/$f.fap" --quiet --folds >"$tmp/folds_$f.txt" 2>&1 ||
     fail "afm-play --folds failed on Song with $f.fap: $(tail -n 3 "$tmp/folds_$f.txt")"
   echo "Song, $f.fap: $(sed -n 's/^turned skin triangles: \([0-9]* of [0-9]* frames turn any\)\(; most [0-9]*\)\{0,1\}.*/\1\2/p' "$tmp/folds_$f.txt")"
 done
+grep -q '^turned skin triangles: 0 of ' "$tmp/folds_joy.txt" ||
+  fail "Song: joy.fap turns skin triangles: $(cat "$tmp/folds_joy.txt")"
 
 # Played together, the FAPs of a real stream move each lip FDP by its own
 # prescription, not by the sum of the FAPs that move it

@@ -1001,17 +1001,13 @@ TEST(FapSynthesis, SkinFaultsSeeAFoldAndASunkVertex) {
   EXPECT_GE(skin_faults(m, E).turned_faces.size(), 1u);
 }
 
-// untangle() (untangle.h) on a flat 6 x 6 grid whose middle vertex is
-// carried across its neighbours: the turned triangles and the vertices
-// around them move as a patch, nothing turns after, and the rest of the
-// field is kept. A patch holding a fixed vertex stays as solved. A field
-// that turns nothing is left alone.
-TEST(Untangle, APatchTurnsNoTriangleAndOneHoldingAFixedVertexStaysAsSolved) {
-  const int k = 6;
-  Eigen::MatrixXd V(k * k, 3);
+// A k x k grid of unit squares in the z = 0 plane, two triangles each
+// (V: #k^2 x 3, vertex i * k + j at (j, i, 0); F: #2(k-1)^2 x 3, facing +z).
+void unit_grid(int k, Eigen::MatrixXd &V, Eigen::MatrixXi &F) {
+  V.resize(k * k, 3);
   for (int i = 0; i < k; ++i)
     for (int j = 0; j < k; ++j) V.row(i * k + j) << j, i, 0;
-  Eigen::MatrixXi F(2 * (k - 1) * (k - 1), 3);
+  F.resize(2 * (k - 1) * (k - 1), 3);
   int f = 0;
   for (int i = 0; i + 1 < k; ++i)
     for (int j = 0; j + 1 < k; ++j) {
@@ -1019,6 +1015,18 @@ TEST(Untangle, APatchTurnsNoTriangleAndOneHoldingAFixedVertexStaysAsSolved) {
       F.row(f++) << a, a + 1, a + k + 1;
       F.row(f++) << a, a + k + 1, a + k;
     }
+}
+
+// untangle() (untangle.h) on a flat 6 x 6 grid whose middle vertex is
+// carried across its neighbours: the turned triangles and the vertices
+// around them move as a patch, nothing turns after, and the rest of the
+// field is kept. A patch holding a fixed vertex stays as solved. A field
+// that turns nothing is left alone.
+TEST(Untangle, APatchTurnsNoTriangleAndOneHoldingAFixedVertexStaysAsSolved) {
+  const int k = 6;
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  unit_grid(k, V, F);
   const int mid = 2 * k + 2;
   Eigen::MatrixXd D = Eigen::MatrixXd::Constant(k * k, 3, 0.0);
   D.col(2).setConstant(0.5);  // all of it lifts
@@ -1059,6 +1067,50 @@ TEST(Untangle, APatchTurnsNoTriangleAndOneHoldingAFixedVertexStaysAsSolved) {
   EXPECT_EQ(x.turned_before, 0);
   EXPECT_EQ(x.moved, 0);
   EXPECT_EQ(G, G0);
+}
+
+// The modiolus (fap_synthesis.h): a neighbour carried past the corner folds
+// the skin beside it; blended toward the corner's motion within the radius,
+// nothing turns, the corner keeps its motion, the skin at or past the radius
+// keeps its own, and a vertex at half the radius takes 9/16 of the corner's.
+TEST(Modiolus, TheSkinAroundTheCornerMovesWithItAndNothingTurns) {
+  const int k = 9;
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  unit_grid(k, V, F);
+  const int corner = 4 * k + 4;
+  Eigen::MatrixXd D = Eigen::MatrixXd::Zero(k * k, 3);
+  for (int v = 0; v < k * k; ++v) D.row(v) << 0.1 * V(v, 1), 0.3, 0.05 * V(v, 0);  // a smooth motion
+  D(corner - 1, 0) += 1.6;  // the neighbour left of the corner passes it
+  ASSERT_GT(turned_faces(V, F, V + D).size(), 0u);
+  const double radius = 3;
+  Eigen::MatrixXd E = D;
+  move_modiolus(V, corner, radius, E);
+  EXPECT_TRUE(turned_faces(V, F, V + E).empty());
+  EXPECT_EQ(E.row(corner), D.row(corner));
+  int inside = 0;
+  for (int v = 0; v < k * k; ++v) {
+    const double r = (V.row(v) - V.row(corner)).norm();
+    if (r >= radius) {
+      EXPECT_EQ(E.row(v), D.row(v)) << "vertex " << v << " at " << r;
+    } else {
+      ++inside;
+      const double w = (1 - r * r / (radius * radius)) * (1 - r * r / (radius * radius));
+      EXPECT_LT((E.row(v) - ((1 - w) * D.row(v) + w * D.row(corner))).norm(), 1e-12) << "vertex " << v;
+    }
+  }
+  EXPECT_EQ(inside, 25);  // (dx, dy) with dx^2 + dy^2 < 9: five columns of five
+  // At half the radius the corner's weight is (1 - 1/4)^2 = 9/16.
+  Eigen::MatrixXd W(2, 3), M(2, 3);
+  W << 0, 0, 0, 1.5, 0, 0;
+  M << 0, 0, 1, 1, 0, 0;
+  move_modiolus(W, 0, radius, M);
+  EXPECT_NEAR(M(1, 2), 9.0 / 16, 1e-15);
+  EXPECT_NEAR(M(1, 0), 7.0 / 16, 1e-15);
+  // No radius, no change.
+  E = D;
+  move_modiolus(V, corner, 0, E);
+  EXPECT_EQ(E, D);
 }
 
 // untangle()'s last step (untangle.h): a sliver whose apex a held vertex
