@@ -268,7 +268,7 @@ static int compare_double(const void *a, const void *b) {
 /* --folds (see usage): the skin triangles counted and their rest normals. */
 typedef struct folds {
   uint32_t *triangle;      /* indices into geometry.triangles */
-  double *normal;          /* [3 x count] rest normals, model units squared */
+  double *normal;          /* [3 x count] rest normals, position quanta squared */
   uint32_t count;          /* skin triangles counted (slivers left out) */
   uint32_t frames;         /* frames turning any */
   uint32_t most, most_frame; /* the most one frame turns, and that frame */
