@@ -171,10 +171,10 @@ int main(int argc, char **argv) {
   static const int16_t da[3] = {5, -7, 9}, db[2] = {-3, 4}, dc[3] = {1, 2, -3};
   static const int16_t na[3] = {-100, 200, 0};
   static const uint16_t eye_parts[1] = {1}, head_parts[2] = {0, 1};
-  static const afm_control eye_controls[2] = {{23, AFM_DOF_ROTATE_Y, 65536},
-                                              {27, AFM_DOF_TRANSLATE_Z, 12000}};
+  static const afm_control eye_controls[2] = {{23, AFM_DOF_ROTATE_Y, 65536, 0},
+                                              {27, AFM_DOF_TRANSLATE_Z, 12000, 0}};
   static const afm_control head_controls[3] = {
-      {48, AFM_DOF_ROTATE_X, 65536}, {49, AFM_DOF_ROTATE_Y, 65536}, {50, AFM_DOF_ROTATE_Z, -65536}};
+      {48, AFM_DOF_ROTATE_X, 65536, 0}, {49, AFM_DOF_ROTATE_Y, 65536, 0}, {50, AFM_DOF_ROTATE_Z, -65536, 0}};
   afm_part parts[2];
   afm_target targets[4];
   afm_rigid rigids[2];

@@ -442,7 +442,8 @@ Expected<std::vector<uint8_t>> encode_afm(const AfmContent &content, afm_profile
       double gain = c.dof >= AFM_DOF_TRANSLATE_X ? c.gain / static_cast<double>(grid.step) : c.gain;
       rigid_controls[i].push_back(
           {static_cast<uint8_t>(c.fap), static_cast<uint8_t>(c.dof),
-           static_cast<int32_t>(std::lround(std::clamp(gain * 65536.0, -2147483647.0, 2147483647.0)))});
+           static_cast<int32_t>(std::lround(std::clamp(gain * 65536.0, -2147483647.0, 2147483647.0))),
+           static_cast<int16_t>(std::clamp(c.knot, -32767, 32767))});
     }
     a.part_count = static_cast<uint16_t>(rigid_parts[i].size());
     a.parts = rigid_parts[i].data();

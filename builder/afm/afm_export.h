@@ -55,6 +55,8 @@ struct RigidPart {
     int fap = 0;
     afm_dof dof = AFM_DOF_ROTATE_X;
     double gain = 0;  // AU per FAP unit (rotations), model units per FAP unit (translations)
+    int knot = 0;     // FAP units, |knot| < 2^15: the control acts on the value's part beyond it
+                      // (afm_control; 0: on the whole value)
   };
   std::vector<Control> controls;
 };

@@ -2,7 +2,9 @@
 
 #include <afm/mpeg4.h>
 
+#include <algorithm>
 #include <tuple>
+#include <utility>
 
 #include "core/fapu.h"
 
@@ -50,6 +52,31 @@ std::vector<RigidPart> eye_and_head_rigids(const Scene &scene, const FdpSet &fdp
   }
   out.push_back(head);
   return out;
+}
+
+std::vector<RigidPart::Control> piecewise_controls(const std::vector<RigidSample> &samples) {
+  std::vector<std::pair<int, afm_dof>> keys;  // (FAP, dof) in first appearance
+  for (const RigidSample &s : samples)
+    if (s.value > 0 && std::find(keys.begin(), keys.end(), std::pair{s.fap, s.dof}) == keys.end())
+      keys.emplace_back(s.fap, s.dof);
+  std::vector<RigidPart::Control> first, knots;
+  for (const auto &[fap, dof] : keys) {
+    std::vector<std::pair<int, double>> at;  // (value, motion), ascending
+    for (const RigidSample &s : samples)
+      if (s.fap == fap && s.dof == dof && s.value > 0 &&
+          std::none_of(at.begin(), at.end(), [&s](const auto &a) { return a.first == s.value; }))
+        at.emplace_back(s.value, s.motion);
+    std::stable_sort(at.begin(), at.end(), [](const auto &a, const auto &b) { return a.first < b.first; });
+    double slope = at[0].second / at[0].first;
+    first.push_back({fap, dof, slope, 0});
+    for (size_t k = 1; k < at.size(); ++k) {
+      const double next = (at[k].second - at[k - 1].second) / (at[k].first - at[k - 1].first);
+      knots.push_back({fap, dof, next - slope, at[k - 1].first});
+      slope = next;
+    }
+  }
+  first.insert(first.end(), knots.begin(), knots.end());
+  return first;
 }
 
 }  // namespace afmb

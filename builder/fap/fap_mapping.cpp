@@ -35,6 +35,12 @@ std::vector<FapMapping> make_table() {
   const char *rigid_head = "head rotation: a rigid control of every part";
   // ---- group 2: jaw, chin, inner lip, corner lip, mid lip ----
   add(3, D::JawOpen, 320, {}, {}, "the jaw's rotation about the condyles");
+  // Streams open the jaw past 320 (Xface's fear.fap to 713): the chin's
+  // skin lags the bone more the wider it opens, so one target extrapolated
+  // folds under the chin (Song: 6 skin triangles at 600, 18 at 1024). The
+  // in-betweens follow it (none up to 1024, 8 at 1200), and the jaw's
+  // controls bend with them (formats/afm.md, RIGD knots).
+  t.back().farther = {640, 1024};
   // Inner lip (2.x) and outer lip (8.x) FAPs use the same groups: the lip
   // moves as one; the FDP measured differs.
   for (int outer = 0; outer < 2; ++outer) {

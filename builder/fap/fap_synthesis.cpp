@@ -400,7 +400,8 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
   struct Result {
     FapOutcome outcome;
     std::optional<MorphTarget> target;
-    std::optional<RigidPart::Control> control, glide;
+    std::optional<RigidPart::Control> control, glide;  // a jaw FAP's: its motion at `at` over `at`
+    int at = 0;                                         // FAP units
   };
   std::vector<Result> results(work.size());
   // The tongue (anatomy/tongue.h), where the face has one with FDPs
@@ -895,23 +896,26 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         } else {
           pose = std::move(*pz);
           ok = true;
+          // The bone's motion at this value, over it (an in-between's too:
+          // the controls bend there, piecewise_controls below).
           RigidPart::Control c;
           c.fap = map->fap;
+          res.at = reference;
           if (map->driver == FapDriver::JawOpen) {
             c.dof = AFM_DOF_ROTATE_X;
-            c.gain = pct / 100.0 * model.jaw.max_open / map->reference / 1e-5;  // AU per FAP unit
+            c.gain = pct / 100.0 * model.jaw.max_open / reference / 1e-5;  // AU per FAP unit
             // The condyles' glide (jaw.h): a second control on the same FAP.
             RigidPart::Control glide;
             glide.fap = map->fap;
             glide.dof = AFM_DOF_TRANSLATE_Z;
-            glide.gain = pct / 100.0 * model.jaw.open_glide / map->reference;
+            glide.gain = pct / 100.0 * model.jaw.open_glide / reference;
             if (side > 0 && glide.gain > 0) res.glide = glide;
           } else if (map->driver == FapDriver::JawThrust) {
             c.dof = AFM_DOF_TRANSLATE_Z;
-            c.gain = pct / 100.0 * model.jaw.max_thrust / map->reference;
+            c.gain = pct / 100.0 * model.jaw.max_thrust / reference;
           } else {
             c.dof = AFM_DOF_TRANSLATE_X;
-            c.gain = pct / 100.0 * model.jaw.max_shift / map->reference;
+            c.gain = pct / 100.0 * model.jaw.max_shift / reference;
           }
           if (side > 0) res.control = c;
         }
@@ -1310,6 +1314,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
   std::vector<char> held(static_cast<size_t>(skin.n), kUntangleFree);
   for (int v = 0; v < skin.n; ++v)
     if (skin.eye_near[static_cast<size_t>(v)] >= 0) held[static_cast<size_t>(v)] = kUntangleHeld;
+  std::vector<RigidSample> jaw_samples;
   for (size_t k = 0; k < results.size(); ++k) {
     Result &r = results[k];
     if (r.target && r.target->displacement[static_cast<size_t>(model.skin)].rows() == 0) {
@@ -1337,10 +1342,14 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       r.outcome.sunk = static_cast<int>(faults.sunk_vertices.size());
       out.targets.push_back(std::move(t));
     }
-    if (r.control) out.jaw.controls.push_back(*r.control);
-    if (r.glide) out.jaw.controls.push_back(*r.glide);
+    if (r.outcome.made)
+      for (const auto &c : {r.control, r.glide})
+        if (c) jaw_samples.push_back({c->fap, c->dof, r.at, c->gain * r.at});
     out.outcomes.push_back(std::move(r.outcome));
   }
+  // The jaw's controls bend at FAP 3's in-betweens, so the teeth are where
+  // each target's bone is (formats/afm.md, RIGD knots).
+  out.jaw.controls = piecewise_controls(jaw_samples);
   if (out.jaw.controls.empty()) out.jaw.parts.clear();
   if (options.sim) lift_synthesis(out, *options.sim);
   return out;

@@ -63,9 +63,7 @@ afm_result afm_rigids_decode(const uint8_t *raw, size_t size, uint64_t file_offs
       afm_control c;
       c.fap = afm_read_u8(&r, "control.fap");
       c.dof = afm_read_u8(&r, "control.dof");
-      if (afm_read_u16(&r, "control.reserved") != 0 && r.error == AFM_OK)
-        return afm_fail(&r, AFM_ERR_RANGE, "rigid %lu control %d: reserved not zero",
-                        (unsigned long)i, k);
+      c.knot = (int16_t)afm_read_u16(&r, "control.knot");
       c.gain_q16 = afm_read_i32(&r, "control.gain");
       if (r.error != AFM_OK) return r.error;
       if (c.fap < 3 || c.fap > 68 || c.dof > AFM_DOF_TRANSLATE_Z)
@@ -106,7 +104,7 @@ afm_result afm_rigids_encode(const afm_rigid *rigids, uint32_t count, afm_writer
     for (k = 0; k < g->control_count; ++k) {
       afm_write_u8(w, g->controls[k].fap);
       afm_write_u8(w, g->controls[k].dof);
-      afm_write_u16(w, 0);
+      afm_write_u16(w, (uint16_t)g->controls[k].knot);
       afm_write_i32(w, g->controls[k].gain_q16);
     }
   }

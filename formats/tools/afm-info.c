@@ -158,7 +158,10 @@ static void print_rigids(const afm_doc *d) {
            (double)(g->origin[2] + (float)r->pivot[2] * g->step));
     for (k = 0; k < r->part_count; ++k) printf(" %s", g->parts[r->parts[k]].name);
     printf("; FAPs");
-    for (k = 0; k < r->control_count; ++k) printf(" %u", r->controls[k].fap);
+    for (k = 0; k < r->control_count; ++k) {
+      printf(" %u", r->controls[k].fap);
+      if (r->controls[k].knot) printf(" (beyond %d)", r->controls[k].knot);
+    }
     printf("\n");
   }
 }

@@ -1,7 +1,7 @@
 /* Rigid parts: eyeballs, jaw and head turn about their pivots (RIGD chunk).
  *
- * Motion of a degree of freedom = sum of FAP value x gain (Q16.16): AU for
- * rotations, quanta for translations. Rotation R = A^T Ry Rx Rz A with A the
+ * Motion of a degree of freedom = sum of FAP value (its part beyond the
+ * control's knot) x gain (Q16.16): AU for rotations, quanta for translations. Rotation R = A^T Ry Rx Rz A with A the
  * rigid's local axes as rows (Q14) and the three axis rotations from integer
  * sines; p' = R p + t with t = pivot - R pivot + A^T translation.
  *
@@ -60,9 +60,12 @@ static void rigid_motion(const afm_rigid *r, const afm_fap_state *a, const afm_f
   int k;
   for (k = 0; k < r->control_count; ++k) {
     const afm_control *c = &r->controls[k];
-    int32_t v = afm_lerp_value(a->value[c->fap], b->value[c->fap], t);
-    /* |v| <= 2^31, |gain| <= 2^31: the product needs 62 bits. */
-    m[c->dof] += afm_round_shift64((int64_t)v * c->gain_q16, 16);
+    int64_t v = afm_lerp_value(a->value[c->fap], b->value[c->fap], t);
+    /* The value's part beyond the knot (formats/afm.md, RIGD). */
+    if (c->knot > 0) v = v > c->knot ? v - c->knot : 0;
+    if (c->knot < 0) v = v < c->knot ? v - c->knot : 0;
+    /* |v| <= 2^31 + 2^15, |gain| <= 2^31: the product is below 2^63. */
+    m[c->dof] += afm_round_shift64(v * c->gain_q16, 16);
   }
   /* Angles within 2^31 AU; translations within 2^24 quanta (80 m at 5 um). */
   for (k = 0; k < 6; ++k) {

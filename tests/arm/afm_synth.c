@@ -313,7 +313,7 @@ static uint32_t make_rigids(const afm_doc *in, afm_rigid *out) {
     if (lower >= 0) {
       afm_rigid *r = &out[n++];
       uint16_t *parts = (uint16_t *)xcalloc(2, sizeof *parts);
-      afm_control *c = (afm_control *)xcalloc(3, sizeof *c);
+      afm_control *c = (afm_control *)xcalloc(5, sizeof *c);
       double radius = 1.4 * m->es0 / step; /* pivot to chin, in quanta */
       memset(r, 0, sizeof *r);
       r->kind = AFM_RIGID_JAW;
@@ -335,8 +335,16 @@ static uint32_t make_rigids(const afm_doc *in, afm_rigid *out) {
       c[2].fap = 15;
       c[2].dof = AFM_DOF_TRANSLATE_X;
       c[2].gain_q16 = q16(-m->mw0 / 1024.0 / step);
+      /* Knots (AFM 1.3): the opening 20 % steeper past 400, the shift
+       * 30 % less steep past -300. */
+      c[3] = c[0];
+      c[3].gain_q16 = q16(0.2 * m->mns0 / step / radius * 1e5 / 1024.0);
+      c[3].knot = 400;
+      c[4] = c[2];
+      c[4].gain_q16 = q16(0.3 * m->mw0 / 1024.0 / step);
+      c[4].knot = -300;
       r->controls = c;
-      r->control_count = 3;
+      r->control_count = 5;
     }
   }
   {

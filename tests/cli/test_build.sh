@@ -22,21 +22,25 @@ bin="$bin/afm-build"
 "$gen" --vertices 1000 -o "$tmp/h.wrl" >/dev/null 2>&1 || fail "afm-headgen failed"
 
 # An AFM with two FAPs, a viseme and an expression: the report, the
-# fidelity report's files, then the AFM as afm-info reads it.
+# fidelity report's files, then the AFM as afm-info reads it. FAP 3 has
+# in-betweens at 640 and 1024, and the jaw's controls bend there.
 "$bin" "$tmp/h.wrl" "$tmp/h.fdp" -q --faps 3,12,v10,e1 --profile raw -o "$tmp/h.afm" --report "$tmp/report" \
   >"$tmp/afm.txt" 2>&1 || fail "an AFM build failed: $(cat "$tmp/afm.txt")"
 grep -q "^3  *open_jaw  *320 " "$tmp/afm.txt" || fail "no report line for open_jaw: $(cat "$tmp/afm.txt")"
+for r in 640 1024; do
+  grep -q "^3  *open_jaw (in-between)  *$r " "$tmp/afm.txt" || fail "no report line for open_jaw at $r"
+done
 grep -q "^12  *raise_l_cornerlip (negative)  *-150 " "$tmp/afm.txt" || fail "no negative side for raise_l_cornerlip"
 grep -q "^v10  *viseme A:  *63 " "$tmp/afm.txt" || fail "no report line for viseme A:"
 grep -q "^e1  *joy  *63 " "$tmp/afm.txt" || fail "no report line for joy"
-grep -q "^targets: 5 made, 0 not made" "$tmp/afm.txt" || fail "no summary: $(cat "$tmp/afm.txt")"
+grep -q "^targets: 7 made, 0 not made" "$tmp/afm.txt" || fail "no summary: $(cat "$tmp/afm.txt")"
 # Only the muscles these targets pose are calibrated (the brows are not).
 grep -q "^zygomaticus_major_left .*[0-9]$" "$tmp/afm.txt" || fail "zygomaticus major left not calibrated"
 grep -q "^frontalis_inner_left .* - *-$" "$tmp/afm.txt" || fail "frontalis calibrated for targets that do not use it"
 r="$tmp/report"
 [ "$(grep -c -x -F -f "$r/report.txt" "$tmp/afm.txt")" -eq "$(wc -l <"$r/report.txt")" ] &&
-  [ "$(wc -l <"$r/report.txt")" -eq 7 ] || fail "report.txt is not the printed table: $(cat "$r/report.txt")"
-[ "$(grep -c '^[a-z]*,' "$r/report.csv")" -eq 6 ] || fail "report.csv: not a header and 5 rows: $(cat "$r/report.csv")"
+  [ "$(wc -l <"$r/report.txt")" -eq 9 ] || fail "report.txt is not the printed table: $(cat "$r/report.txt")"
+[ "$(grep -c '^[a-z]*,' "$r/report.csv")" -eq 8 ] || fail "report.csv: not a header and 7 rows: $(cat "$r/report.csv")"
 grep -q '^viseme,10,"viseme A:",1,63,1,1,' "$r/report.csv" || fail "report.csv: no viseme A: row"
 # The off-axis error's parts across the face and in depth make it up
 # (squares add), and the summary gives their medians.
@@ -45,7 +49,7 @@ grep -q "off-axis median [0-9.]*% worst [0-9.]*% (across the face median [0-9.]*
 awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) c[$i] = i; next }
   $1 == "fap" { ++n; o = $c["off_axis"]; f = $c["off_face"]; d = $c["off_depth"]
     if (f < 0 || d < 0 || (f * f + d * d - o * o) ^ 2 > 1e-8 * (o * o + 1e-12) ^ 2) bad = bad " " $2 }
-  END { exit (n != 3 || bad != "") }' "$r/report.csv" ||
+  END { exit (n != 5 || bad != "") }' "$r/report.csv" ||
   fail "report.csv: off_face and off_depth do not make up off_axis: $(cat "$r/report.csv")"
 # Helpers steer the raised corner back onto FAP 12's direction, and the
 # message names them; with --no-steer the group acts alone.
@@ -55,15 +59,17 @@ grep -q '^fap,12,"raise_l_cornerlip",1,.*steered by .*orbicularis_oris' "$r/repo
   >"$tmp/alone.txt" 2>&1 || fail "a build with --no-steer failed: $(cat "$tmp/alone.txt")"
 grep -q '^fap,12,"raise_l_cornerlip",1,' "$tmp/alone/report.csv" && ! grep -q steered "$tmp/alone/report.csv" ||
   fail "--no-steer: $(grep '^fap,12' "$tmp/alone/report.csv")"
-# The contact sheet: neutral and 5 targets of 240 x 288 in one row, 4-pixel gaps.
-for t in neutral fap03 fap12 fap12-neg viseme10 expression1; do
+# The contact sheet: neutral and 7 targets of 240 x 288 in one row, 4-pixel gaps.
+for t in neutral fap03 fap03-640 fap03-1024 fap12 fap12-neg viseme10 expression1; do
   [ -s "$r/targets/$t.png" ] || fail "no picture targets/$t.png"
   grep -q "targets/$t.png" "$r/index.html" || fail "index.html does not show targets/$t.png"
 done
 size=$(od -An -tu1 -j16 -N8 "$r/sheet.png" | awk '{ printf "%dx%d", $3 * 256 + $4, $7 * 256 + $8 }')
-[ "$size" = "1468x296" ] || fail "sheet.png is $size, not 6 tiles of 240x288 in a row (1468x296)"
+[ "$size" = "1956x296" ] || fail "sheet.png is $size, not 8 tiles of 240x288 in a row (1956x296)"
 "$info" --targets "$tmp/h.afm" >"$tmp/info.txt" 2>&1 || fail "afm-info cannot read the AFM"
 grep -q "FAP  *3  *open_jaw  *320" "$tmp/info.txt" || fail "afm-info lists no open_jaw target: $(cat "$tmp/info.txt")"
+grep -q "^  jaw .*; FAPs 3 3 3 (beyond 320) 3 (beyond 640) 3 (beyond 320) 3 (beyond 640)$" "$tmp/info.txt" ||
+  fail "afm-info shows no jaw controls bent at 320 and 640: $(grep '^  jaw' "$tmp/info.txt")"
 grep -qi "viseme  *10 " "$tmp/info.txt" || fail "afm-info lists no viseme 10: $(cat "$tmp/info.txt")"
 
 # A skin of 2,000 vertices is simulated on 1,000 of them (the default; 999

@@ -178,6 +178,9 @@ static inline void hash_rigid(hasher *s, const afm_rigid *r) {
     hash_u8(s, r->controls[i].fap);
     hash_u8(s, r->controls[i].dof);
     hash_i32(s, r->controls[i].gain_q16);
+    /* Hashed where set, so that documents without knots (before 1.3) keep
+     * their golden hashes. */
+    if (r->controls[i].knot) hash_u16(s, (uint16_t)r->controls[i].knot);
   }
 }
 

@@ -224,20 +224,27 @@ const afm_doc *make_synthetic_doc(SyntheticDoc &s, const SyntheticOptions &o) {
   }
 
   s.rigid_parts = {1, 0, 1};
-  s.controls = {{23, AFM_DOF_ROTATE_Y, 1 << 16}, {25, AFM_DOF_ROTATE_X, 1 << 16},
-                {27, AFM_DOF_TRANSLATE_Z, 3 << 15}, {48, AFM_DOF_ROTATE_X, 1 << 16}};
+  s.controls = {{23, AFM_DOF_ROTATE_Y, 1 << 16, 0}, {25, AFM_DOF_ROTATE_X, 1 << 16, 0},
+                {27, AFM_DOF_TRANSLATE_Z, 3 << 15, 0}};
+  if (o.in_betweens) {
+    // Knots (version 1.3): the yaw half as steep past 20000, the pitch
+    // twice as steep below -15000.
+    s.controls.push_back({23, AFM_DOF_ROTATE_Y, -(1 << 15), 20000});
+    s.controls.push_back({25, AFM_DOF_ROTATE_X, 1 << 16, -15000});
+  }
+  s.controls.push_back({48, AFM_DOF_ROTATE_X, 1 << 16, 0});
   afm_rigid eye_rig{};
   eye_rig.kind = AFM_RIGID_EYE_LEFT;
   eye_rig.pivot[0] = 4000, eye_rig.pivot[1] = 6000, eye_rig.pivot[2] = 12000;
   eye_rig.axes[0] = eye_rig.axes[4] = eye_rig.axes[8] = 16384;
   eye_rig.part_count = 1, eye_rig.parts = &s.rigid_parts[0];
-  eye_rig.control_count = 3, eye_rig.controls = &s.controls[0];
+  eye_rig.control_count = static_cast<uint16_t>(s.controls.size() - 1), eye_rig.controls = &s.controls[0];
   afm_rigid head{};
   head.kind = AFM_RIGID_HEAD;
   head.pivot[1] = -20000;
   head.axes[0] = head.axes[4] = head.axes[8] = 16384;
   head.part_count = 2, head.parts = &s.rigid_parts[1];
-  head.control_count = 1, head.controls = &s.controls[3];
+  head.control_count = 1, head.controls = &s.controls.back();
   s.rigids = {eye_rig, head};
 
   s.fdps = {{2, 1, 0, {0.0f, -0.12f, 0.05f}}, {3, 5, skin_v, {0.04f, 0.06f, 0.135f}},
@@ -368,7 +375,7 @@ std::string compare_docs(const afm_doc &a, const afm_doc &b) {
       return "rigid " + std::to_string(i);
     for (uint32_t k = 0; k < x.control_count; ++k)
       if (x.controls[k].fap != y.controls[k].fap || x.controls[k].dof != y.controls[k].dof ||
-          x.controls[k].gain_q16 != y.controls[k].gain_q16)
+          x.controls[k].gain_q16 != y.controls[k].gain_q16 || x.controls[k].knot != y.controls[k].knot)
         return "rigid control " + std::to_string(i);
   }
   return d.str();

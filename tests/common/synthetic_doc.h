@@ -50,7 +50,9 @@ struct SyntheticOptions {
   // deltas then.
   bool lift = false;
   // In-between targets (formats/afm.md, version 1.2): FAP 12 also at 1024
-  // and 1800, FAP 31 also at -700, each with a field of its own.
+  // and 1800, FAP 31 also at -700, each with a field of its own; and the
+  // eye's yaw (23) and pitch (25) bent at knots (version 1.3): half as
+  // steep past 20000, twice as steep below -15000.
   bool in_betweens = false;
 };
 

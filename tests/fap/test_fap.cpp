@@ -222,14 +222,16 @@ Eigen::Vector3d direction_of(int fap) {
 TEST(FapSynthesis, EachTargetMovesItsFdpByReferenceTimesFapuAlongTheFapsDirection) {
   const FaceModel &m = head_1k().model;
   const FapSynthesis &s = synthesis();
-  // 3 (positive only), 12 and 33 (both sides), then a viseme and two
-  // expressions.
-  ASSERT_EQ(s.outcomes.size(), 8u);
+  // 3 (positive only, with its in-betweens at 640 and 1024), 12 and 33
+  // (both sides), then a viseme and two expressions.
+  ASSERT_EQ(s.outcomes.size(), 10u);
   for (const FapOutcome &o : s.outcomes) {
     if (o.kind != AFM_TARGET_FAP) continue;
-    SCOPED_TRACE("FAP " + std::to_string(o.number) + " side " + std::to_string(o.side));
+    SCOPED_TRACE("FAP " + std::to_string(o.number) + " at " + std::to_string(o.reference));
     ASSERT_TRUE(o.made) << o.message;
-    const MorphTarget *t = target(o.number, o.side);
+    const MorphTarget *t = nullptr;
+    for (const MorphTarget &x : s.targets)
+      if (x.kind == AFM_TARGET_FAP && x.number == o.number && x.reference == o.reference) t = &x;
     ASSERT_NE(t, nullptr);
     EXPECT_EQ(t->reference, o.reference);
     EXPECT_EQ(o.reference > 0, o.side > 0);
@@ -272,45 +274,74 @@ TEST(FapSynthesis, EachTargetMovesItsFdpByReferenceTimesFapuAlongTheFapsDirectio
   }
 }
 
-TEST(FapSynthesis, TheJawsRigidControlMovesTheChinAsTheTargetDoes) {
+// The motion of FAP `fap`'s controls of `dof` at `value`, by the rule of
+// formats/afm.md (RIGD): each control's gain times the value's part beyond
+// its knot.
+double control_motion(const RigidPart &r, int fap, afm_dof dof, double value) {
+  double m = 0;
+  for (const RigidPart::Control &c : r.controls) {
+    if (c.fap != fap || c.dof != dof) continue;
+    const double u = c.knot > 0 ? std::max(value - c.knot, 0.0) : c.knot < 0 ? std::min(value - c.knot, 0.0) : value;
+    m += c.gain * u;
+  }
+  return m;
+}
+
+TEST(FapSynthesis, TheJawsRigidControlsMoveTheChinAsEachTargetDoes) {
   const FaceModel &m = head_1k().model;
   const FapSynthesis &s = synthesis();
   ASSERT_FALSE(s.jaw.parts.empty()) << "the reference head has lower teeth and a tongue";
-  // FAP 3 turns the jaw about x and glides it forward (jaw.h).
-  ASSERT_EQ(s.jaw.controls.size(), 2u);
+  // FAP 3 turns the jaw about x and glides it forward (jaw.h), whole
+  // values first; its in-betweens bend both at knots.
+  ASSERT_GE(s.jaw.controls.size(), 2u);
   const RigidPart::Control &c = s.jaw.controls[0], &g = s.jaw.controls[1];
   EXPECT_EQ(c.fap, 3);
   EXPECT_EQ(c.dof, AFM_DOF_ROTATE_X);
+  EXPECT_EQ(c.knot, 0);
   EXPECT_EQ(g.fap, 3);
   EXPECT_EQ(g.dof, AFM_DOF_TRANSLATE_Z);
-  const MorphTarget *t = target(3, +1);
-  ASSERT_NE(t, nullptr);
-  // At the reference value the rigid turns by gain x reference AU about x
-  // through the pivot and moves forward by its glide: the motion the pose
-  // gave the jaw's bone.
-  const double angle = c.gain * t->reference * 1e-5, glide = g.gain * t->reference;
-  double scale = 0;
-  for (const FapOutcome &o : s.outcomes)
-    if (o.kind == AFM_TARGET_FAP && o.number == 3) scale = o.scale;
-  EXPECT_NEAR(angle, scale * m.jaw.max_open, 1e-12);
-  EXPECT_NEAR(glide, scale * m.jaw.open_glide, 1e-12);
-  // The chin drops: the glide takes back most of the rotation's swing
-  // toward the throat (all of it at 100 %).
-  const Eigen::Vector3d chin = at_fdp(*t, 2, 1);
-  EXPECT_LT(std::abs(chin.z()), 0.25 * -chin.y()) << chin.transpose();
-  // The skin over the jaw follows the bone through the tissue: on average
-  // within 15 % of the rigid motion, or the lower teeth would part from the lip.
-  const Eigen::MatrixXd &D = t->displacement[static_cast<size_t>(m.skin)];
-  ASSERT_FALSE(m.jaw.vertices.empty());
-  double off = 0, rigid = 0;
-  for (int v : m.jaw.vertices) {
-    const Eigen::Vector3d p = m.tissue.X0.row(v).transpose();
-    const Eigen::Vector3d q = s.jaw.pivot + Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitX()) * (p - s.jaw.pivot) +
-                              glide * Eigen::Vector3d::UnitZ();
-    off += (D.row(v).transpose() - (q - p)).norm();
-    rigid += (q - p).norm();
+  EXPECT_EQ(g.knot, 0);
+  int made = 0;
+  for (const FapOutcome &o : s.outcomes) {
+    if (o.kind != AFM_TARGET_FAP || o.number != 3 || !o.made) continue;
+    ++made;
+    const MorphTarget *t = nullptr;
+    for (const MorphTarget &x : s.targets)
+      if (x.kind == AFM_TARGET_FAP && x.number == 3 && x.reference == o.reference) t = &x;
+    ASSERT_NE(t, nullptr) << o.reference;
+    SCOPED_TRACE("FAP 3 at " + std::to_string(t->reference));
+    // At each target's value the rigid turns about x through the pivot and
+    // glides forward by what the pose gave the jaw's bone: the teeth stay
+    // where that target's bone is, at the in-betweens too.
+    const double angle = control_motion(s.jaw, 3, AFM_DOF_ROTATE_X, t->reference) * 1e-5,
+                 glide = control_motion(s.jaw, 3, AFM_DOF_TRANSLATE_Z, t->reference);
+    EXPECT_NEAR(angle, o.scale * m.jaw.max_open, 1e-9 * m.jaw.max_open);
+    EXPECT_NEAR(glide, o.scale * m.jaw.open_glide, 1e-9 * m.jaw.open_glide);
+    // The chin drops by the value: the glide takes back most of the
+    // rotation's swing toward the throat (all of it at 100 %).
+    const Eigen::Vector3d chin = at_fdp(*t, 2, 1);
+    EXPECT_LT(std::abs(chin.z()), 0.25 * -chin.y()) << chin.transpose();
+    // The skin over the jaw follows the bone through the tissue: on average
+    // within 15 % of the rigid motion, or the lower teeth would part from
+    // the lip.
+    const Eigen::MatrixXd &D = t->displacement[static_cast<size_t>(m.skin)];
+    ASSERT_FALSE(m.jaw.vertices.empty());
+    double off = 0, rigid = 0;
+    for (int v : m.jaw.vertices) {
+      const Eigen::Vector3d p = m.tissue.X0.row(v).transpose();
+      const Eigen::Vector3d q = s.jaw.pivot + Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitX()) * (p - s.jaw.pivot) +
+                                glide * Eigen::Vector3d::UnitZ();
+      off += (D.row(v).transpose() - (q - p)).norm();
+      rigid += (q - p).norm();
+    }
+    EXPECT_LT(off, 0.15 * rigid);
+    std::printf("FAP 3 at %d: the jaw turns %.4f rad (%.4f per 1024 units), the skin over it %.1f %% off the bone\n",
+                t->reference, angle, angle / t->reference * 1024, 100 * off / rigid);
   }
-  EXPECT_LT(off, 0.15 * rigid);
+  // The reference and both in-betweens (fap_mapping.cpp: 640, 1024), and a
+  // knot at each nearer reference on both controls.
+  EXPECT_EQ(made, 3);
+  EXPECT_EQ(s.jaw.controls.size(), 2u + 2u * static_cast<size_t>(made - 1));
 }
 
 TEST(FapSynthesis, TheCornerGoesUpForPositiveValuesAndDownForNegativeOnes) {
@@ -2104,12 +2135,17 @@ TEST(FapSynthesis, SongsOpeningJawTakesItsChinAlongAndTurnsNoTriangle) {
   o.sim = &sm.sim;
   Expected<FapSynthesis> syn = synthesize_faps(sm.scene, sm.model, o);
   ASSERT_TRUE(syn.is_ok()) << syn.status().message();
-  ASSERT_EQ(syn->targets.size(), 1u);
-  ASSERT_TRUE(syn->outcomes[0].made) << syn->outcomes[0].message;
+  // The reference (320) and the in-betweens (640, 1024), none folded.
+  ASSERT_EQ(syn->targets.size(), 3u);
+  for (size_t k = 0; k < 3; ++k) {
+    ASSERT_TRUE(syn->outcomes[k].made) << syn->outcomes[k].message;
+    const Eigen::MatrixXd &Dk = syn->targets[k].displacement[static_cast<size_t>(sm.sim.skin)];
+    ASSERT_EQ(Dk.rows(), part.V.rows());
+    EXPECT_EQ(turned_over(part.V, part.F, part.V + Dk), 0) << "at " << syn->targets[k].reference;
+    EXPECT_EQ(syn->outcomes[k].turned, 0) << "at " << syn->targets[k].reference;
+  }
+  ASSERT_EQ(syn->targets[0].reference, 320);
   const Eigen::MatrixXd &D = syn->targets[0].displacement[static_cast<size_t>(sm.sim.skin)];
-  ASSERT_EQ(D.rows(), part.V.rows());
-  EXPECT_EQ(turned_over(part.V, part.F, part.V + D), 0);
-  EXPECT_EQ(syn->outcomes[0].turned, 0);
   // The jaw's own pose at that opening, before any untangling: 2.1 and the
   // nearest simulation vertex under it on the midline, 1 to 10 mm lower.
   const FaceModel &m = sm.model;
@@ -2237,11 +2273,16 @@ TEST(FapSynthesis, TheAfmHoldsTheTargetsAndTheJaw) {
                t.reference == doc->targets[i].reference;
     EXPECT_TRUE(found) << "target " << int(doc->targets[i].number) << " ref " << doc->targets[i].reference;
   }
+  // The jaw's controls as the synthesis made them, knots included.
   bool jaw = false;
-  for (uint32_t i = 0; i < doc->rigid_count; ++i)
-    if (doc->rigids[i].kind == AFM_RIGID_JAW)
-      jaw = doc->rigids[i].control_count == 2 && doc->rigids[i].controls[0].fap == 3 &&
-            doc->rigids[i].controls[1].fap == 3;
+  for (uint32_t i = 0; i < doc->rigid_count; ++i) {
+    const afm_rigid &r = doc->rigids[i];
+    if (r.kind != AFM_RIGID_JAW || r.control_count != s.jaw.controls.size()) continue;
+    jaw = true;
+    for (size_t k = 0; k < s.jaw.controls.size(); ++k)
+      jaw = jaw && r.controls[k].fap == s.jaw.controls[k].fap && r.controls[k].dof == s.jaw.controls[k].dof &&
+            r.controls[k].knot == s.jaw.controls[k].knot;
+  }
   EXPECT_TRUE(jaw);
 }
 

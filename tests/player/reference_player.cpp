@@ -1,5 +1,6 @@
 #include "reference_player.h"
 
+#include <algorithm>
 #include <cmath>
 #include <iterator>
 #include <map>
@@ -195,6 +196,8 @@ ReferencePose reference_pose(const afm_doc &doc, const afm_fap_state &a, const a
       for (uint16_t k = 0; k < rg.control_count; ++k) {
         const afm_control &c = rg.controls[k];
         double v = a.value[c.fap] + (double(b.value[c.fap]) - a.value[c.fap]) * t;
+        if (c.knot > 0) v = std::max(v - c.knot, 0.0);
+        if (c.knot < 0) v = std::min(v - c.knot, 0.0);
         m[c.dof] += v * c.gain_q16 / 65536.0;
       }
       Mat A{}, At{};

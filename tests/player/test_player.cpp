@@ -711,3 +711,70 @@ TEST(Player, InBetweenGoldenPerFrameHash) {
   expect_golden_frames(m, states, 30000,
                        {0x5b18097c2add03a2ull, 0x7dfeb00c08335741ull, 0x7938bfe3781c57ebull, 0xb9b0726dd6640126ull});
 }
+
+// Control knots (formats/afm.md, RIGD, version 1.3): the synthetic eye's
+// yaw (FAP 23, 1 AU per unit) is half as steep past 20000 and its pitch
+// (FAP 25) twice as steep below -15000. The angles are read back from the
+// pose's rotation, whose Q14 entries resolve 6 AU: a slope that did not
+// bend would be 5000 AU or more off at the values below.
+TEST(Player, ControlKnotsBendTheRigidMotionWhereTheyLie) {
+  SyntheticModel m(false, true);
+  const afm_rigid *eye = nullptr;
+  for (uint32_t r = 0; r < m.doc->rigid_count; ++r)
+    if (m.doc->rigids[r].kind == AFM_RIGID_EYE_LEFT) eye = &m.doc->rigids[r];
+  ASSERT_NE(eye, nullptr);
+  // The angle in AU about y (yaw) or x (pitch) for states a..b at t.
+  auto angle = [&](const afm_fap_state &a, const afm_fap_state &b, afm_q16 t, bool yaw) {
+    afm_rigid_transform x;
+    EXPECT_EQ(afm_rigid_pose(eye, &a, &b, t, &x), AFM_OK);
+    return (yaw ? std::atan2(x.rotation[2], x.rotation[0]) : std::atan2(x.rotation[7], x.rotation[4])) / 1e-5;
+  };
+  struct Case {
+    int fap;
+    int32_t value;
+    double au;
+  };
+  const Case cases[] = {
+      {23, 10000, 10000},  {23, 20000, 20000},   {23, 30000, 25000},   {23, 60000, 40000},
+      {23, -30000, -30000},  // the knot lies on the positive side only
+      {25, 10000, 10000},  {25, -15000, -15000}, {25, -20000, -25000}, {25, -25000, -35000},
+  };
+  for (const Case &c : cases) {
+    const afm_fap_state s = state({{c.fap, c.value}});
+    EXPECT_NEAR(angle(s, s, 0, c.fap == 23), c.au, 8) << "FAP " << c.fap << " at " << c.value;
+  }
+  // Between frames the value is interpolated first, then taken beyond the
+  // knot: halfway from 10000 to 30000 is 20000, at the knot (not the mean
+  // of 10000 and 25000 AU).
+  EXPECT_NEAR(angle(state({{23, 10000}}), state({{23, 30000}}), 32768, true), 20000, 8);
+  // The whole pose against the double model, the eye's vertices included:
+  // the weights' budget and the rigid term of FixedPointMatchesTheDoubleModel.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const afm_geometry &g = m.doc->geometry;
+  double worst = 0;
+  for (int trial = 0; trial < 30; ++trial) {
+    afm_fap_state a = state({}), b = state({});
+    for (afm_fap_state *s : {&a, &b}) {
+      s->value[12] = int32_t(std::lround(u(rng) * 2400));
+      s->value[23] = int32_t(std::lround(u(rng) * 45000));
+      s->value[25] = int32_t(std::lround(u(rng) * 30000));
+    }
+    const afm_q16 t = afm_q16(rng() % 65537);
+    ASSERT_EQ(afm_player_pose(m.player, &a, &b, t), AFM_OK);
+    const afmtest::ReferencePose ref = afmtest::reference_pose(*m.doc, a, b, t / 65536.0);
+    double morph = 0.5;
+    for (uint32_t i = 0; i < m.doc->target_count; ++i)
+      if (ref.weights[i] != 0) morph += largest_delta(m.doc->targets[i]) / 4096.0;
+    for (uint32_t v = 0; v < g.vertex_count; ++v) {
+      const double reach = std::hypot(g.px[v] - eye->pivot[0], g.py[v] - eye->pivot[1], g.pz[v] - eye->pivot[2]);
+      const double bound = morph + (reach + 2 * morph) * 4 * 3 / 16384.0 + 1.0;
+      for (int k = 0; k < 3; ++k) {
+        const double e = std::fabs(afm_player_positions(m.player)[3 * size_t(v) + size_t(k)] - ref.positions[v][size_t(k)]);
+        ASSERT_LE(e, bound) << "trial " << trial << " vertex " << v << " axis " << k;
+        worst = std::max(worst, e);
+      }
+    }
+  }
+  std::printf("control knots, fixed vs double over 30 random poses: worst error %.3f quanta\n", worst);
+}

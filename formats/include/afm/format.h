@@ -88,7 +88,7 @@ void afm_free(const afm_allocator *allocator, void *ptr);
 
 #define AFM_MAGIC_SIZE 8          /* 0x89 'A' 'F' 'M' '\r' '\n' 0x1A '\n' */
 #define AFM_VERSION_MAJOR 1
-#define AFM_VERSION_MINOR 2 /* 1.1 added LIFT, 1.2 in-between targets */
+#define AFM_VERSION_MINOR 3 /* 1.1 added LIFT, 1.2 in-between targets, 1.3 control knots */
 
 #define AFM_FOURCC(a, b, c, d)                                        \
   ((uint32_t)(uint8_t)(a) | ((uint32_t)(uint8_t)(b) << 8) |           \
@@ -279,13 +279,18 @@ typedef enum afm_dof {
   AFM_DOF_TRANSLATE_Z = 5
 } afm_dof;
 
-/* One FAP driving one degree of freedom: motion = FAP value * gain.
- * Rotations: gain in AU (1e-5 rad) per FAP unit; translations: position
- * quanta per FAP unit. Q16.16. */
+/* One FAP driving one degree of freedom: motion = u * gain, where u is the
+ * FAP value v's part beyond the knot (since 1.3): u = v when knot = 0;
+ * v - knot when knot > 0 and v > knot, or knot < 0 and v < knot; else 0.
+ * Controls of one FAP and dof with knots at its in-between targets'
+ * references make the motion piecewise linear in v, as the targets are
+ * (formats/afm.md, RIGD). Rotations: gain in AU (1e-5 rad) per FAP unit;
+ * translations: position quanta per FAP unit. Q16.16. */
 typedef struct afm_control {
   uint8_t fap; /* 3..68 */
   uint8_t dof; /* afm_dof */
   int32_t gain_q16;
+  int16_t knot; /* FAP units; 0: the whole value */
 } afm_control;
 
 /* A rigid transform about a pivot: eyeballs, jaw, head. */
