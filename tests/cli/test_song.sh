@@ -182,6 +182,19 @@ faps="6 7 12 13 53 54 59 60"
   fail "afm-play --folds failed on Song's corners: $(tail -n 3 "$tmp/folds_corners.txt")"
 grep -q '^turned skin triangles: 0 of 9 frames' "$tmp/folds_corners.txt" ||
   fail "Song: the lip corners' FAPs sent in pairs turn skin triangles: $(cat "$tmp/folds_corners.txt")"
+# The jaw opened alone past FAP 3's reference (320), as Xface's fear.fap
+# opens it to 713: one target extrapolated turned 3, 6, 11, 12, 14 and 18
+# skin triangles at 480 ... 1024; the in-betweens at 640 and 1024 (the
+# jaw's controls bent there, formats/afm.md) turn none.
+awk 'BEGIN { n = split("0 480 600 713 800 900 1024", v, " "); print "2.1 jaw 25 " n
+  for (k = 1; k <= n; ++k) {
+    for (f = 1; f <= 68; ++f) printf "%s%d", (f > 1 ? " " : ""), (f == 3)
+    printf "\n%d %d\n", k - 1, v[k] } }' >"$tmp/jaw.fap"
+grep -q "^3  *open_jaw (in-between)  *1024 " "$tmp/build.txt" || fail "Song: no in-between of FAP 3 at 1024"
+"$bin/afm-play" "$tmp/song.afm" "$tmp/jaw.fap" --quiet --folds >"$tmp/folds_jaw.txt" 2>&1 ||
+  fail "afm-play --folds failed on Song's jaw: $(tail -n 3 "$tmp/folds_jaw.txt")"
+grep -q '^turned skin triangles: 0 of 7 frames' "$tmp/folds_jaw.txt" ||
+  fail "Song: the jaw opened to 480..1024 turns skin triangles: $(cat "$tmp/folds_jaw.txt")"
 for f in joy anger fear; do
   "$bin/afm-play" "$tmp/song.afm" "$AFM_SHARED_DIR/data/fap/xface/$f.fap" --quiet --folds >"$tmp/folds_$f.txt" 2>&1 ||
     fail "afm-play --folds failed on Song with $f.fap: $(tail -n 3 "$tmp/folds_$f.txt")"
