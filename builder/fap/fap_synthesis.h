@@ -9,7 +9,9 @@
 // 15) set the jaw's rotation or translation so that the chin (2.1) moves by
 // the same rule, then solve the tissue around it (secant steps, each from
 // the pose of the largest motion solved so far not past its own); the jaw's rigid parts
-// (lower teeth, tongue) get a control with the same motion.
+// (lower teeth, tongue) get a control with the same motion, bent at FAP 3's
+// in-betweens (afm/rigid_parts.h, piecewise_controls), so that at each
+// target's value the teeth are where its bone is.
 //
 // The tongue's FAPs (43-47) are no solve: the tongue part's own motion
 // (anatomy/tongue.h), exact at its FDP, where the face has a tongue with
@@ -23,7 +25,8 @@
 // In-betweens (FapMapping::farther; formats/afm.md): the same solve at each
 // farther reference, kept only where the group reaches it in full. The
 // player blends a side's targets piecewise linearly, so a lid follows its
-// arc over the eyeball up to there.
+// arc over the eyeball up to there, and the jaw's skin its bone (the chin's
+// skin lags the bone more the wider the jaw opens).
 //
 // An eyelid FAP's closing side whose lid driver was calibrated to less than
 // the table's range (the generated heads: no equilibrium at their lids'
