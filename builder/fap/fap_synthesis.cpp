@@ -400,8 +400,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
   struct Result {
     FapOutcome outcome;
     std::optional<MorphTarget> target;
-    std::optional<RigidPart::Control> control, glide;  // a jaw FAP's: its motion at `at` over `at`
-    int at = 0;                                         // FAP units
+    std::vector<RigidSample> jaw;  // a jaw FAP's bone motion at its value (piecewise_controls)
   };
   std::vector<Result> results(work.size());
   // The tongue (anatomy/tongue.h), where the face has one with FDPs
@@ -896,28 +895,20 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         } else {
           pose = std::move(*pz);
           ok = true;
-          // The bone's motion at this value, over it (an in-between's too:
-          // the controls bend there, piecewise_controls below).
-          RigidPart::Control c;
-          c.fap = map->fap;
-          res.at = reference;
-          if (map->driver == FapDriver::JawOpen) {
-            c.dof = AFM_DOF_ROTATE_X;
-            c.gain = pct / 100.0 * model.jaw.max_open / reference / 1e-5;  // AU per FAP unit
+          // The bone's motion at this value (an in-between's too: the
+          // controls bend there, piecewise_controls below), for the jaw's
+          // rigid parts.
+          const double s = pct / 100.0;
+          if (side > 0 && map->driver == FapDriver::JawOpen) {
+            res.jaw.push_back({map->fap, AFM_DOF_ROTATE_X, reference, s * model.jaw.max_open / 1e-5});  // AU
             // The condyles' glide (jaw.h): a second control on the same FAP.
-            RigidPart::Control glide;
-            glide.fap = map->fap;
-            glide.dof = AFM_DOF_TRANSLATE_Z;
-            glide.gain = pct / 100.0 * model.jaw.open_glide / reference;
-            if (side > 0 && glide.gain > 0) res.glide = glide;
-          } else if (map->driver == FapDriver::JawThrust) {
-            c.dof = AFM_DOF_TRANSLATE_Z;
-            c.gain = pct / 100.0 * model.jaw.max_thrust / reference;
-          } else {
-            c.dof = AFM_DOF_TRANSLATE_X;
-            c.gain = pct / 100.0 * model.jaw.max_shift / reference;
+            if (s * model.jaw.open_glide > 0)
+              res.jaw.push_back({map->fap, AFM_DOF_TRANSLATE_Z, reference, s * model.jaw.open_glide});
+          } else if (side > 0) {
+            const bool thrust = map->driver == FapDriver::JawThrust;
+            res.jaw.push_back({map->fap, thrust ? AFM_DOF_TRANSLATE_Z : AFM_DOF_TRANSLATE_X, reference,
+                               s * (thrust ? model.jaw.max_thrust : model.jaw.max_shift)});
           }
-          if (side > 0) res.control = c;
         }
       }
     } else if (lid_cut) {
@@ -1342,9 +1333,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       r.outcome.sunk = static_cast<int>(faults.sunk_vertices.size());
       out.targets.push_back(std::move(t));
     }
-    if (r.outcome.made)
-      for (const auto &c : {r.control, r.glide})
-        if (c) jaw_samples.push_back({c->fap, c->dof, r.at, c->gain * r.at});
+    if (r.outcome.made) jaw_samples.insert(jaw_samples.end(), r.jaw.begin(), r.jaw.end());
     out.outcomes.push_back(std::move(r.outcome));
   }
   // The jaw's controls bend at FAP 3's in-betweens, so the teeth are where

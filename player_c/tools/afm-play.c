@@ -290,11 +290,12 @@ static void triangle_normal(const afm_geometry *g, const int32_t *x, uint32_t tr
 }
 
 /* The skin's triangles with their rest normals (in quanta: only the sign of
- * a dot product is used), slivers under a thousandth of the mean left out. */
+ * a dot product is used), slivers under a thousandth of the mean left out:
+ * every skin triangle first, then the slivers dropped in place. */
 static int folds_init(folds *fo, const afm_doc *doc) {
   const afm_geometry *g = &doc->geometry;
-  uint32_t part, tri, total = 0;
-  double sum = 0, n[3];
+  uint32_t part, tri, i, total = 0;
+  double sum = 0;
   memset(fo, 0, sizeof *fo);
   for (part = 0; part < g->part_count; ++part)
     if (g->parts[part].kind == AFM_PART_SKIN) total += g->parts[part].triangle_count;
@@ -305,20 +306,18 @@ static int folds_init(folds *fo, const afm_doc *doc) {
     const afm_part *a = &g->parts[part];
     if (a->kind != AFM_PART_SKIN) continue;
     for (tri = a->first_triangle; tri < a->first_triangle + a->triangle_count; ++tri) {
+      double *n = fo->normal + 3 * fo->count;
       triangle_normal(g, NULL, tri, n);
       sum += sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      fo->triangle[fo->count++] = tri;
     }
   }
-  for (part = 0; part < g->part_count; ++part) {
-    const afm_part *a = &g->parts[part];
-    if (a->kind != AFM_PART_SKIN) continue;
-    for (tri = a->first_triangle; tri < a->first_triangle + a->triangle_count; ++tri) {
-      triangle_normal(g, NULL, tri, n);
-      if (!(sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) > 1e-3 * sum / total)) continue;
-      fo->triangle[fo->count] = tri;
-      memcpy(fo->normal + 3 * fo->count, n, sizeof n);
-      ++fo->count;
-    }
+  for (i = 0, fo->count = 0; i < total; ++i) {
+    const double *n = fo->normal + 3 * i;
+    if (!(sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) > 1e-3 * sum / total)) continue;
+    fo->triangle[fo->count] = fo->triangle[i];
+    memmove(fo->normal + 3 * fo->count, n, 3 * sizeof *n);
+    ++fo->count;
   }
   return 1;
 }
@@ -346,7 +345,7 @@ static uint32_t folds_add(folds *fo, const afm_doc *doc, const afm_player *p, ui
     fo->most_frame = frame;
     fo->most_state = *a;
     for (f = 0; f <= AFM_FAP_COUNT; ++f)
-      fo->most_state.value[f] = a->value[f] + (int32_t)(((int64_t)(b->value[f] - a->value[f]) * t) / 65536);
+      fo->most_state.value[f] = a->value[f] + (int32_t)floor(((double)b->value[f] - a->value[f]) * t / 65536.0 + 0.5);
   }
   return turned;
 }

@@ -163,33 +163,33 @@ done
 # 12 + 59 turned 4 triangles at each of Song's corners and joy.fap turned
 # some in 94 of its 108 frames. Now neither the pairs at their references
 # (frames 1-8) nor joy.fap turns any.
-faps="6 7 12 13 53 54 59 60"
-{
-  echo "2.1 corners 25 9"
-  for k in 0 1 2 3 4 5 6 7 8; do
-    awk 'BEGIN { for (f = 1; f <= 68; ++f) printf "%s%d", (f > 1 ? " " : ""), (f == 6 || f == 7 || f == 12 || f == 13 || f == 53 || f == 54 || f == 59 || f == 60); printf "\n" }'
-    awk -v k="$k" -v faps="$faps" 'BEGIN {
-      n = split(faps, f, " ")
-      split("0 12:150,59:150 12:-150,59:-150 13:150,60:150 13:-150,60:-150 6:70,53:70 6:-70,53:-70 7:70,54:70 7:-70,54:-70", rows, " ")
-      m = split(rows[k + 1], pairs, ",")
-      for (i = 1; i <= m; ++i) { split(pairs[i], q, ":"); v[q[1]] = q[2] }
-      printf "%d", k
+# fap_stream NAME FAPS ROWS: a stream at 25 fps sending FAPS (numbers, space
+# separated) in every frame, a frame per row of ROWS: "0" (all at 0) or
+# "fap:value,fap:value,..." (the others at 0).
+fap_stream() {
+  awk -v name="$1" -v faps="$2" -v rows="$3" 'BEGIN {
+    n = split(faps, f, " "); m = split(rows, row, " ")
+    for (i = 1; i <= n; ++i) on[f[i]] = 1
+    print "2.1 " name " 25 " m
+    for (k = 1; k <= m; ++k) {
+      for (g = 1; g <= 68; ++g) printf "%s%d", (g > 1 ? " " : ""), ((g "") in on)
+      split("", v); p = split(row[k], pairs, ",")
+      for (i = 1; i <= p; ++i) if (split(pairs[i], q, ":") == 2) v[q[1]] = q[2]
+      printf "\n%d", k - 1
       for (i = 1; i <= n; ++i) printf " %d", v[f[i]]
-      printf "\n" }'
-  done
-} >"$tmp/corners.fap"
+      printf "\n" } }'
+}
+fap_stream corners "6 7 12 13 53 54 59 60" "0 12:150,59:150 12:-150,59:-150 13:150,60:150 13:-150,60:-150 \
+6:70,53:70 6:-70,53:-70 7:70,54:70 7:-70,54:-70" >"$tmp/corners.fap"
 "$bin/afm-play" "$tmp/song.afm" "$tmp/corners.fap" --quiet --folds >"$tmp/folds_corners.txt" 2>&1 ||
   fail "afm-play --folds failed on Song's corners: $(tail -n 3 "$tmp/folds_corners.txt")"
 grep -q '^turned skin triangles: 0 of 9 frames' "$tmp/folds_corners.txt" ||
   fail "Song: the lip corners' FAPs sent in pairs turn skin triangles: $(cat "$tmp/folds_corners.txt")"
 # The jaw opened alone past FAP 3's reference (320), as Xface's fear.fap
-# opens it to 713: one target extrapolated turned 3, 6, 11, 12, 14 and 18
-# skin triangles at 480 ... 1024; the in-betweens at 640 and 1024 (the
-# jaw's controls bent there, formats/afm.md) turn none.
-awk 'BEGIN { n = split("0 480 600 713 800 900 1024", v, " "); print "2.1 jaw 25 " n
-  for (k = 1; k <= n; ++k) {
-    for (f = 1; f <= 68; ++f) printf "%s%d", (f > 1 ? " " : ""), (f == 3)
-    printf "\n%d %d\n", k - 1, v[k] } }' >"$tmp/jaw.fap"
+# opens it to 713: one target extrapolated turned 3, 6, 12, 12, 14 and 18
+# skin triangles at 480, 600, 713, 800, 900 and 1024; the in-betweens at 640
+# and 1024 (the jaw's controls bent there, formats/afm.md) turn none.
+fap_stream jaw 3 "0 3:480 3:600 3:713 3:800 3:900 3:1024" >"$tmp/jaw.fap"
 grep -q "^3  *open_jaw (in-between)  *1024 " "$tmp/build.txt" || fail "Song: no in-between of FAP 3 at 1024"
 "$bin/afm-play" "$tmp/song.afm" "$tmp/jaw.fap" --quiet --folds >"$tmp/folds_jaw.txt" 2>&1 ||
   fail "afm-play --folds failed on Song's jaw: $(tail -n 3 "$tmp/folds_jaw.txt")"

@@ -190,6 +190,13 @@ const MorphTarget *target(int fap, int side) {
   return nullptr;
 }
 
+// A FAP's target at `reference` (its side's nearest, or an in-between), or nullptr.
+const MorphTarget *target_at(int fap, int reference) {
+  for (const MorphTarget &t : synthesis().targets)
+    if (t.kind == AFM_TARGET_FAP && t.number == fap && t.reference == reference) return &t;
+  return nullptr;
+}
+
 // A viseme's or an expression's target, or nullptr.
 const MorphTarget *high_level_target(afm_target_kind kind, int number) {
   for (const MorphTarget &t : synthesis().targets)
@@ -229,9 +236,7 @@ TEST(FapSynthesis, EachTargetMovesItsFdpByReferenceTimesFapuAlongTheFapsDirectio
     if (o.kind != AFM_TARGET_FAP) continue;
     SCOPED_TRACE("FAP " + std::to_string(o.number) + " at " + std::to_string(o.reference));
     ASSERT_TRUE(o.made) << o.message;
-    const MorphTarget *t = nullptr;
-    for (const MorphTarget &x : s.targets)
-      if (x.kind == AFM_TARGET_FAP && x.number == o.number && x.reference == o.reference) t = &x;
+    const MorphTarget *t = target_at(o.number, o.reference);
     ASSERT_NE(t, nullptr);
     EXPECT_EQ(t->reference, o.reference);
     EXPECT_EQ(o.reference > 0, o.side > 0);
@@ -305,9 +310,7 @@ TEST(FapSynthesis, TheJawsRigidControlsMoveTheChinAsEachTargetDoes) {
   for (const FapOutcome &o : s.outcomes) {
     if (o.kind != AFM_TARGET_FAP || o.number != 3 || !o.made) continue;
     ++made;
-    const MorphTarget *t = nullptr;
-    for (const MorphTarget &x : s.targets)
-      if (x.kind == AFM_TARGET_FAP && x.number == 3 && x.reference == o.reference) t = &x;
+    const MorphTarget *t = target_at(3, o.reference);
     ASSERT_NE(t, nullptr) << o.reference;
     SCOPED_TRACE("FAP 3 at " + std::to_string(t->reference));
     // At each target's value the rigid turns about x through the pivot and

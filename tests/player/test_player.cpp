@@ -158,7 +158,6 @@ uint64_t fnv1a(uint64_t h, const void *data, size_t n) {
   return h;
 }
 
-// Hash of a pose, serialised little-endian so the value is the same on any host.
 // The largest |position delta| component of a target, in quanta.
 int32_t largest_delta(const afm_target &tg) {
   int32_t md = 0;
@@ -166,6 +165,18 @@ int32_t largest_delta(const afm_target &tg) {
     md = std::max({md, std::abs(int32_t(tg.dx[k])), std::abs(int32_t(tg.dy[k])), std::abs(int32_t(tg.dz[k]))});
   return md;
 }
+
+// The weights' part of a pose's error budget, in quanta: `weight_error` (a
+// weight's error, as a fraction of 1) times the largest delta of each target
+// the double model gives a weight.
+double weight_budget(const afm_doc &doc, const afmtest::ReferencePose &ref, double weight_error) {
+  double b = 0;
+  for (uint32_t i = 0; i < doc.target_count; ++i)
+    if (ref.weights[i] != 0) b += largest_delta(doc.targets[i]) * weight_error;
+  return b;
+}
+
+// Hash of a pose, serialised little-endian so the value is the same on any host.
 
 uint64_t pose_hash(const afm_player *p, uint32_t vertices) {
   uint64_t h = 1469598103934665603ull;
@@ -201,12 +212,7 @@ TEST(Player, FixedPointMatchesTheDoubleModelWithinTheStatedBound) {
     const double t = (rng() % 65537) / 65536.0;
     ASSERT_EQ(afm_player_pose(m.player, &a, &b, afm_q16(std::lround(t * 65536))), AFM_OK);
     afmtest::ReferencePose ref = afmtest::reference_pose(*m.doc, a, b, std::lround(t * 65536) / 65536.0);
-    double morph_budget = 0.5;
-    for (uint32_t i = 0; i < m.doc->target_count; ++i) {
-      if (ref.weights[i] == 0) continue;
-      const int32_t md = largest_delta(m.doc->targets[i]);
-      morph_budget += md / 8192.0;
-    }
+    const double morph_budget = 0.5 + weight_budget(*m.doc, ref, 1.0 / 8192);
     // Largest distance from any vertex to any pivot, for the rigid term.
     double reach = 0;
     const afm_geometry &g = m.doc->geometry;
@@ -556,12 +562,7 @@ TEST(Player, LiftedVerticesMatchTheDoubleModel) {
     const afm_q16 t = afm_q16(rng() % 65537);
     ASSERT_EQ(afm_player_pose(m.player, &a, &b, t), AFM_OK);
     const afmtest::ReferencePose ref = afmtest::reference_pose(*m.doc, a, b, t / 65536.0);
-    double budget = 0.5 + 1.0 / 8192;
-    for (uint32_t i = 0; i < m.doc->target_count; ++i) {
-      if (ref.weights[i] == 0) continue;
-      const int32_t md = largest_delta(m.doc->targets[i]);
-      budget += md / 8192.0;
-    }
+    const double budget = 0.5 + 1.0 / 8192 + weight_budget(*m.doc, ref, 1.0 / 8192);
     // The skin (all bound) only: the eye also turns, which the rigid test covers.
     const uint32_t skin = g.parts[0].vertex_count;
     for (uint32_t v = 0; v < skin; ++v) {
@@ -685,12 +686,8 @@ TEST(Player, InBetweenTargetsMatchTheDoubleModel) {
     const afm_q16 t = afm_q16(rng() % 65537);
     ASSERT_EQ(afm_player_pose(m.player, &a, &b, t), AFM_OK);
     const afmtest::ReferencePose ref = afmtest::reference_pose(*m.doc, a, b, t / 65536.0);
-    double budget = 0.5;
-    for (uint32_t i = 0; i < m.doc->target_count; ++i) {
-      if (ref.weights[i] == 0) continue;
-      const int32_t md = largest_delta(m.doc->targets[i]);
-      budget += md / 4096.0;  // half a Q12 unit from the weight's rounding, half from the lerp's
-    }
+    // Half a Q12 unit of weight from the weight's rounding, half from the lerp's.
+    const double budget = 0.5 + weight_budget(*m.doc, ref, 1.0 / 4096);
     const uint32_t skin = m.doc->geometry.parts[0].vertex_count;
     for (uint32_t v = 0; v < skin; ++v)
       for (int k = 0; k < 3; ++k) {
@@ -763,9 +760,7 @@ TEST(Player, ControlKnotsBendTheRigidMotionWhereTheyLie) {
     const afm_q16 t = afm_q16(rng() % 65537);
     ASSERT_EQ(afm_player_pose(m.player, &a, &b, t), AFM_OK);
     const afmtest::ReferencePose ref = afmtest::reference_pose(*m.doc, a, b, t / 65536.0);
-    double morph = 0.5;
-    for (uint32_t i = 0; i < m.doc->target_count; ++i)
-      if (ref.weights[i] != 0) morph += largest_delta(m.doc->targets[i]) / 4096.0;
+    const double morph = 0.5 + weight_budget(*m.doc, ref, 1.0 / 4096);
     for (uint32_t v = 0; v < g.vertex_count; ++v) {
       const double reach = std::hypot(g.px[v] - eye->pivot[0], g.py[v] - eye->pivot[1], g.pz[v] - eye->pivot[2]);
       const double bound = morph + (reach + 2 * morph) * 4 * 3 / 16384.0 + 1.0;
