@@ -7,14 +7,110 @@
 
 namespace afmb {
 
-bool BlockLdlt::analyze(const SpMat &pattern) {
+namespace {
+
+template <int B>
+using MatB = Eigen::Matrix<double, B, B>;
+template <int B>
+using MapB = Eigen::Map<MatB<B>>;
+template <int B>
+using ConstMapB = Eigen::Map<const MatB<B>>;
+
+// The float copies' column length for b x b blocks: a 3 x 3 block's
+// columns padded to 4 (a block times a vector is three 4-wide
+// multiply-adds), a 9 x 9 block's left at 9 (padded to 12 they are a third
+// more memory to read, and the solves are then memory-bound: Song's AFM took
+// 6 % more CPU).
+constexpr int float_rows(int b) { return b == 3 ? 4 : b; }
+
+// acc -= M z: M is b columns of P floats, z has at least b.
+template <int B, int P>
+inline void subtract_product(float *acc, const float *M, const float *z) {
+  for (int c = 0; c < B; ++c) {
+    const float s = z[c];
+    for (int r = 0; r < P; ++r) acc[r] -= M[c * P + r] * s;
+  }
+}
+
+// out = M z: M is b columns of P floats, z has at least b.
+template <int B, int P>
+inline void product(float *out, const float *M, const float *z) {
+  for (int r = 0; r < P; ++r) out[r] = M[r] * z[0];
+  for (int c = 1; c < B; ++c)
+    for (int r = 0; r < P; ++r) out[r] += M[c * P + r] * z[c];
+}
+
+// The float copy of a b x b block: M, or its transpose, as b columns of P.
+template <int B, int P>
+inline void to_float(const double *M, bool transpose, float *out) {
+  for (int c = 0; c < B; ++c) {
+    for (int r = 0; r < B; ++r) out[c * P + r] = static_cast<float>(transpose ? M[r * B + c] : M[c * B + r]);
+    for (int r = B; r < P; ++r) out[c * P + r] = 0.f;
+  }
+}
+
+// The hot loops of 9 x 9 blocks are compiled twice, for AVX2 and for the
+// baseline, and the CPU picks one when the program loads (GCC's
+// target_clones). Each entry is the same sequence of multiplies and adds at
+// any vector width (no fused multiply-add: the "avx2" target does not
+// include FMA), so both give the same bits: Song's AFM built with
+// AFM_NO_KERNEL_CLONES is byte for byte the same file.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(AFM_NO_KERNEL_CLONES)
+#define AFM_KERNEL_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define AFM_KERNEL_CLONES
+#endif
+// y[rows[q]] -= L_q Y for q < count: 9 x 9 blocks, column-major (the
+// factorisation's inner loop). A column of the result is summed in
+// registers; __restrict lets the compiler vectorise it.
+AFM_KERNEL_CLONES void column_update9(double *__restrict y, const int *__restrict rows, const double *__restrict L,
+                                         int count, const double *__restrict Y) {
+  for (int q = 0; q < count; ++q) {
+    double *__restrict C = y + static_cast<size_t>(rows[q]) * 81;
+    const double *__restrict A = L + static_cast<size_t>(q) * 81;
+    for (int j = 0; j < 9; ++j) {
+      double c[9];
+      for (int i = 0; i < 9; ++i) c[i] = C[j * 9 + i];
+      for (int k = 0; k < 9; ++k) {
+        const double s = Y[j * 9 + k];
+        for (int i = 0; i < 9; ++i) c[i] -= A[k * 9 + i] * s;
+      }
+      for (int i = 0; i < 9; ++i) C[j * 9 + i] = c[i];
+    }
+  }
+}
+
+template <int B>
+void column_update(double *y, const int *rows, const double *L, int count, const double *Y) {
+  if constexpr (B == 9) {
+    column_update9(y, rows, L, count, Y);
+  } else {
+    const Eigen::Map<const MatB<B>> Ym(Y);
+    for (int q = 0; q < count; ++q)
+      MapB<B>(y + static_cast<size_t>(rows[q]) * B * B).noalias() -= ConstMapB<B>(L + static_cast<size_t>(q) * B * B) * Ym;
+  }
+}
+
+}  // namespace
+
+bool BlockLdlt::analyze(const SpMat &pattern, int group, bool upper_only) {
   *this = BlockLdlt();
   const Eigen::Index n = pattern.rows();
-  if (n != pattern.cols() || n % 3 != 0 || !pattern.isCompressed()) return false;
+  if (n != pattern.cols() || n % 3 != 0 || !pattern.isCompressed() || (group != 1 && group != 3)) return false;
   const int nodes = static_cast<int>(n / 3);
+  if (nodes % group != 0) return false;
+  const int groups = nodes / group;
   const int *outer = pattern.outerIndexPtr(), *inner = pattern.innerIndexPtr();
-  // The node graph, checking the block layout on the way.
-  std::vector<Eigen::Triplet<double>> graph;
+  // Each node's blocks (node, r) as where K holds them, checking the block
+  // layout on the way: stored in the node's column, or, with upper_only,
+  // for r > node, as the mirror (r's column, row node) transposed. Blocks
+  // stored below the diagonal are then skipped, so a pattern of both
+  // triangles or of the upper one alone will do.
+  struct Source {
+    int other, node, offset;
+    bool transpose;
+  };
+  std::vector<std::vector<Source>> blocks_of(static_cast<size_t>(nodes));
   for (int j = 0; j < nodes; ++j) {
     const int begin = outer[3 * j], count = outer[3 * j + 1] - begin;
     if (count % 3 != 0) return false;
@@ -25,33 +121,45 @@ bool BlockLdlt::analyze(const SpMat &pattern) {
     for (int p = 0; p < count; p += 3) {
       const int r = inner[begin + p];
       if (r % 3 != 0 || inner[begin + p + 1] != r + 1 || inner[begin + p + 2] != r + 2) return false;
-      graph.emplace_back(r / 3, j, 1.0);
+      if (upper_only && r / 3 > j) continue;
+      blocks_of[static_cast<size_t>(j)].push_back({r / 3, j, p, false});
+      if (upper_only && r / 3 < j) blocks_of[static_cast<size_t>(r / 3)].push_back({j, j, p, true});
     }
   }
-  SpMat g(nodes, nodes);
-  g.setFromTriplets(graph.begin(), graph.end());
+  // The groups' graph.
+  std::vector<Eigen::Triplet<double>> graph;
+  for (int j = 0; j < nodes; ++j)
+    for (const Source &b : blocks_of[static_cast<size_t>(j)]) graph.emplace_back(b.other / group, j / group, 1.0);
+  SpMat g(groups, groups);
+  g.setFromTriplets(graph.begin(), graph.end());  // repeats summed: the pattern is what counts
   Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> amd;
   Eigen::AMDOrdering<int>()(g, amd);
-  nodes_ = nodes;
-  order_.assign(amd.indices().data(), amd.indices().data() + nodes);
-  position_.assign(static_cast<size_t>(nodes), 0);
-  for (int k = 0; k < nodes; ++k) position_[static_cast<size_t>(order_[static_cast<size_t>(k)])] = k;
+  group_ = group;
+  b_ = 3 * group;
+  pad_ = float_rows(b_);
+  blocks_ = groups;
+  order_.assign(amd.indices().data(), amd.indices().data() + groups);
+  position_.assign(static_cast<size_t>(groups), 0);
+  for (int k = 0; k < groups; ++k) position_[static_cast<size_t>(order_[static_cast<size_t>(k)])] = k;
 
-  upper_.assign(static_cast<size_t>(nodes), {});
-  for (int k = 0; k < nodes; ++k) {
-    const int old = order_[static_cast<size_t>(k)], begin = outer[3 * old];
-    std::vector<UpperBlock> &u = upper_[static_cast<size_t>(k)];
-    for (int p = begin; p < outer[3 * old + 1]; p += 3) {
-      const int i = position_[static_cast<size_t>(inner[p] / 3)];
-      if (i <= k) u.push_back({i, p - begin});
+  upper_.assign(static_cast<size_t>(groups), {});
+  for (int k = 0; k < groups; ++k) {
+    std::vector<Gather> &u = upper_[static_cast<size_t>(k)];
+    for (int cc = 0; cc < group; ++cc) {
+      const int node = order_[static_cast<size_t>(k)] * group + cc;
+      for (const Source &b : blocks_of[static_cast<size_t>(node)]) {
+        const int i = position_[static_cast<size_t>(b.other / group)];
+        if (i <= k)
+          u.push_back({i, 3 * cc * b_ + 3 * (b.other % group), b.node, b.offset, b.transpose});
+      }
     }
-    std::sort(u.begin(), u.end(), [](const UpperBlock &a, const UpperBlock &b) { return a.row < b.row; });
+    std::sort(u.begin(), u.end(), [](const Gather &a, const Gather &b) { return a.row < b.row || (a.row == b.row && a.dst < b.dst); });
   }
   // The elimination tree (Liu's algorithm, with path compression).
-  parent_.assign(static_cast<size_t>(nodes), -1);
-  std::vector<int> ancestor(static_cast<size_t>(nodes), -1);
-  for (int k = 0; k < nodes; ++k)
-    for (const UpperBlock &b : upper_[static_cast<size_t>(k)])
+  parent_.assign(static_cast<size_t>(groups), -1);
+  std::vector<int> ancestor(static_cast<size_t>(groups), -1);
+  for (int k = 0; k < groups; ++k)
+    for (const Gather &b : upper_[static_cast<size_t>(k)])
       for (int i = b.row; i != -1 && i < k;) {
         const int next = ancestor[static_cast<size_t>(i)];
         ancestor[static_cast<size_t>(i)] = k;
@@ -59,13 +167,13 @@ bool BlockLdlt::analyze(const SpMat &pattern) {
         i = next;
       }
   // L's column counts: row k of L is the reach of column k's upper part.
-  flag_.assign(static_cast<size_t>(nodes), -1);
-  std::vector<int> count(static_cast<size_t>(nodes), 0);
-  row_start_.assign(static_cast<size_t>(nodes) + 1, 0);
-  for (int k = 0; k < nodes; ++k) {
+  flag_.assign(static_cast<size_t>(groups), -1);
+  std::vector<int> count(static_cast<size_t>(groups), 0);
+  row_start_.assign(static_cast<size_t>(groups) + 1, 0);
+  for (int k = 0; k < groups; ++k) {
     flag_[static_cast<size_t>(k)] = k;
     int in_row = 0;
-    for (const UpperBlock &b : upper_[static_cast<size_t>(k)])
+    for (const Gather &b : upper_[static_cast<size_t>(k)])
       for (int i = b.row; flag_[static_cast<size_t>(i)] != k; i = parent_[static_cast<size_t>(i)]) {
         ++count[static_cast<size_t>(i)];
         ++in_row;
@@ -73,43 +181,56 @@ bool BlockLdlt::analyze(const SpMat &pattern) {
       }
     row_start_[static_cast<size_t>(k) + 1] = row_start_[static_cast<size_t>(k)] + in_row;
   }
-  col_start_.assign(static_cast<size_t>(nodes) + 1, 0);
-  for (int i = 0; i < nodes; ++i) {
+  col_start_.assign(static_cast<size_t>(groups) + 1, 0);
+  for (int i = 0; i < groups; ++i) {
     const double c = count[static_cast<size_t>(i)];
     col_start_[static_cast<size_t>(i) + 1] = col_start_[static_cast<size_t>(i)] + count[static_cast<size_t>(i)];
-    // Scalar column 3i + t holds 3c entries below the block and 2 - t in it.
-    for (int t = 0; t < 3; ++t) factor_flops_ += (3 * c + 2 - t) * (3 * c + 2 - t);
-    nonzeros_ += 9 * c + 3;
+    // Scalar column b i + t holds b c entries below the block and b - 1 - t in it.
+    for (int t = 0; t < b_; ++t) factor_flops_ += (b_ * c + b_ - 1 - t) * (b_ * c + b_ - 1 - t);
+    nonzeros_ += b_ * b_ * c + b_ * (b_ - 1) / 2.0;
   }
-  const size_t blocks = static_cast<size_t>(col_start_.back());
+  const size_t blocks = static_cast<size_t>(col_start_.back()), bb = static_cast<size_t>(b_ * b_),
+               fb = static_cast<size_t>(b_ * pad_);
   row_.assign(blocks, 0);
-  l_.assign(blocks, M3::Zero());
-  d_inverse_.assign(static_cast<size_t>(nodes), M3::Zero());
-  y_.assign(static_cast<size_t>(nodes), M3::Zero());
-  reach_.assign(static_cast<size_t>(nodes), 0);
-  stack_.assign(static_cast<size_t>(nodes), 0);
-  filled_.assign(static_cast<size_t>(nodes), 0);
+  l_.assign(blocks * bb, 0.0);
+  d_inverse_.assign(static_cast<size_t>(groups) * bb, 0.0);
+  y_.assign(static_cast<size_t>(groups) * bb, 0.0);
+  reach_.assign(static_cast<size_t>(groups), 0);
+  stack_.assign(static_cast<size_t>(groups), 0);
+  filled_.assign(static_cast<size_t>(groups), 0);
+  lf_.assign(blocks * fb, 0.f);
+  lrf_.assign(blocks * fb, 0.f);
+  rcol_.assign(blocks, 0);
+  df_.assign(static_cast<size_t>(groups) * fb, 0.f);
   return true;
 }
 
 BlockLdlt::Result BlockLdlt::factorize(const SpMat &K) {
+  return b_ == 9 ? factorize_blocks<9>(K) : factorize_blocks<3>(K);
+}
+
+template <int B>
+BlockLdlt::Result BlockLdlt::factorize_blocks(const SpMat &K) {
+  constexpr int BB = B * B, P = float_rows(B);
   const int *outer = K.outerIndexPtr();
   const double *val = K.valuePtr();
   std::fill(flag_.begin(), flag_.end(), -1);
   std::fill(filled_.begin(), filled_.end(), 0);
-  lrf_.resize(static_cast<size_t>(row_start_.back()));
-  rcol_.resize(static_cast<size_t>(row_start_.back()));
   bool definite = true;
-  for (int k = 0; k < nodes_; ++k) {
-    const int old = order_[static_cast<size_t>(k)];
-    M3 dk = M3::Zero();
+  MatB<B> dk;
+  for (int k = 0; k < blocks_; ++k) {
+    dk.setZero();
     // Scatter column k's upper blocks into y and find the reach (the
     // pattern of row k of L) in topological order.
-    int top = nodes_;
+    int top = blocks_;
     flag_[static_cast<size_t>(k)] = k;
-    for (const UpperBlock &b : upper_[static_cast<size_t>(k)]) {
-      M3 &dst = b.row == k ? dk : y_[static_cast<size_t>(b.row)];
-      for (int c = 0; c < 3; ++c) dst.col(c) = Eigen::Map<const Eigen::Vector3d>(val + outer[3 * old + c] + b.offset);
+    for (const Gather &b : upper_[static_cast<size_t>(k)]) {
+      double *dst = (b.row == k ? dk.data() : &y_[static_cast<size_t>(b.row) * BB]) + b.dst;
+      for (int c = 0; c < 3; ++c) {
+        const double *src = val + outer[3 * b.node + c] + b.offset;
+        if (b.transpose) dst[c] = src[0], dst[B + c] = src[1], dst[2 * B + c] = src[2];
+        else dst[c * B] = src[0], dst[c * B + 1] = src[1], dst[c * B + 2] = src[2];
+      }
       if (b.row == k) continue;
       int len = 0;
       for (int i = b.row; flag_[static_cast<size_t>(i)] != k; i = parent_[static_cast<size_t>(i)]) {
@@ -119,92 +240,133 @@ BlockLdlt::Result BlockLdlt::factorize(const SpMat &K) {
       while (len > 0) reach_[static_cast<size_t>(--top)] = stack_[static_cast<size_t>(--len)];
     }
     // Row k of L, and D_k.
-    for (int p = top; p < nodes_; ++p) {
+    for (int p = top; p < blocks_; ++p) {
       const size_t i = static_cast<size_t>(reach_[static_cast<size_t>(p)]);
-      const M3 yi = y_[i];
-      y_[i].setZero();
+      MapB<B> yref(&y_[i * BB]);
+      const MatB<B> yi = yref;
+      yref.setZero();
       const int end = col_start_[i] + filled_[i];
-      for (int q = col_start_[i]; q < end; ++q)
-        y_[static_cast<size_t>(row_[static_cast<size_t>(q)])].noalias() -= l_[static_cast<size_t>(q)] * yi;
-      const M3 lki = (d_inverse_[i] * yi).transpose();
-      dk.noalias() -= lki * yi;
+      column_update<B>(y_.data(), &row_[static_cast<size_t>(col_start_[i])], &l_[static_cast<size_t>(col_start_[i]) * BB],
+                       end - col_start_[i], yi.data());
+      // -(D_i^-1 Y_i), then L(k, i) its transpose negated (exact).
+      MatB<B> minus = MatB<B>::Zero();
+      const int zero = 0;
+      column_update<B>(minus.data(), &zero, &d_inverse_[i * BB], 1, yi.data());
+      const MatB<B> lki = -minus.transpose();
+      column_update<B>(dk.data(), &zero, lki.data(), 1, yi.data());
       row_[static_cast<size_t>(end)] = k;
-      l_[static_cast<size_t>(end)] = lki;
+      MapB<B> lslot(&l_[static_cast<size_t>(end) * BB]);
+      lslot = lki;
       const size_t slot = static_cast<size_t>(row_start_[static_cast<size_t>(k)] + (p - top));
-      lrf_[slot].setZero();
-      lrf_[slot].topRows<3>() = lki.cast<float>();
+      to_float<B, P>(lki.data(), false, &lrf_[slot * B * P]);
       rcol_[slot] = static_cast<int>(i);
       ++filled_[i];
     }
-    const Eigen::LDLT<M3> pivots(dk);
-    const Eigen::Vector3d d = pivots.vectorD();
+    const Eigen::LDLT<MatB<B>> pivots(dk);
+    const Eigen::Matrix<double, B, 1> d = pivots.vectorD();
     if (!d.allFinite() || !(d.array().abs() > 0).all()) return Result::kSingular;
     definite = definite && (d.array() > 0).all();
-    d_inverse_[static_cast<size_t>(k)] = dk.inverse();
-    if (!d_inverse_[static_cast<size_t>(k)].allFinite()) return Result::kSingular;
+    MapB<B> dinv(&d_inverse_[static_cast<size_t>(k) * BB]);
+    dinv = dk.inverse();
+    if (!dinv.allFinite()) return Result::kSingular;
+    to_float<B, P>(dinv.data(), false, &df_[static_cast<size_t>(k) * B * P]);
   }
-  lf_.resize(l_.size());
-  for (size_t q = 0; q < l_.size(); ++q) {
-    lf_[q].setZero();
-    lf_[q].topRows<3>() = l_[q].transpose().cast<float>();
-  }
-  df_.resize(d_inverse_.size());
-  for (size_t q = 0; q < d_inverse_.size(); ++q) {
-    df_[q].setZero();
-    df_[q].topRows<3>() = d_inverse_[q].cast<float>();
-  }
+  for (size_t q = 0; q < row_.size(); ++q) to_float<B, P>(&l_[q * BB], true, &lf_[q * B * P]);
   return definite ? Result::kDefinite : Result::kIndefinite;
 }
 
-// x = P^T L^-T D^-1 L^-1 P b.
 void BlockLdlt::solve(const Eigen::VectorXd &b, Eigen::VectorXd &x) const {
-  std::vector<Eigen::Vector3d> &z = solve_work_;
-  const size_t n = order_.size();
-  z.resize(n);
-  for (size_t i = 0; i < n; ++i) z[i] = b.segment<3>(3 * order_[i]);
-  for (size_t i = 0; i < n; ++i)
-    for (int q = col_start_[i]; q < col_start_[i + 1]; ++q)
-      z[static_cast<size_t>(row_[static_cast<size_t>(q)])].noalias() -= l_[static_cast<size_t>(q)] * z[i];
-  for (size_t i = 0; i < n; ++i) z[i] = d_inverse_[i] * z[i];
-  for (size_t i = n; i-- > 0;)
-    for (int q = col_start_[i]; q < col_start_[i + 1]; ++q)
-      z[i].noalias() -= l_[static_cast<size_t>(q)].transpose() * z[static_cast<size_t>(row_[static_cast<size_t>(q)])];
-  x.resize(b.size());
-  for (size_t i = 0; i < n; ++i) x.segment<3>(3 * order_[i]) = z[i];
+  if (b_ == 9) solve_blocks<9>(b, x);
+  else solve_blocks<3>(b, x);
 }
 
-// As solve(), in single precision.
-void BlockLdlt::precondition(const Eigen::VectorXd &b, Eigen::VectorXd &x) const {
-  std::vector<V4f, Eigen::aligned_allocator<V4f>> &z = solve_work_f_;
+// x = P^T L^-T D^-1 L^-1 P b.
+template <int B>
+void BlockLdlt::solve_blocks(const Eigen::VectorXd &b, Eigen::VectorXd &x) const {
+  using Vb = Eigen::Matrix<double, B, 1>;
+  constexpr int BB = B * B;
+  std::vector<double> &zs = solve_work_;
   const size_t n = order_.size();
-  z.resize(n);
-  // Forward by rows: row k's sum stays in a register, where a pass by
-  // columns would read and write z once per block.
-  for (size_t k = 0; k < n; ++k) {
-    V4f acc(static_cast<float>(b[3 * order_[k]]), static_cast<float>(b[3 * order_[k] + 1]),
-            static_cast<float>(b[3 * order_[k] + 2]), 0.f);
-    for (int e = row_start_[k]; e < row_start_[k + 1]; ++e) {
-      const M43f &l = lrf_[static_cast<size_t>(e)];
-      const V4f &zi = z[static_cast<size_t>(rcol_[static_cast<size_t>(e)])];
-      acc -= l.col(0) * zi[0] + l.col(1) * zi[1] + l.col(2) * zi[2];
-    }
-    z[k] = acc;
-  }
+  zs.resize(n * B);
+  auto z = [&](size_t i) { return Eigen::Map<Vb>(&zs[i * B]); };
+  for (size_t i = 0; i < n; ++i) z(i) = b.segment<B>(B * order_[i]);
   for (size_t i = 0; i < n; ++i) {
-    const V4f zi = z[i];
-    z[i] = df_[i].col(0) * zi[0] + df_[i].col(1) * zi[1] + df_[i].col(2) * zi[2];
+    const Vb zi = z(i);
+    for (int q = col_start_[i]; q < col_start_[i + 1]; ++q)
+      z(static_cast<size_t>(row_[static_cast<size_t>(q)])).noalias() -= ConstMapB<B>(&l_[static_cast<size_t>(q) * BB]) * zi;
   }
+  for (size_t i = 0; i < n; ++i) z(i) = (ConstMapB<B>(&d_inverse_[i * BB]) * z(i)).eval();
   for (size_t i = n; i-- > 0;) {
-    V4f acc = z[i];
-    for (int q = col_start_[i]; q < col_start_[i + 1]; ++q) {
-      const M43f &l = lf_[static_cast<size_t>(q)];
-      const V4f &zq = z[static_cast<size_t>(row_[static_cast<size_t>(q)])];
-      acc -= l.col(0) * zq[0] + l.col(1) * zq[1] + l.col(2) * zq[2];
-    }
-    z[i] = acc;
+    Vb acc = z(i);
+    for (int q = col_start_[i]; q < col_start_[i + 1]; ++q)
+      acc.noalias() -= ConstMapB<B>(&l_[static_cast<size_t>(q) * BB]).transpose() * z(static_cast<size_t>(row_[static_cast<size_t>(q)]));
+    z(i) = acc;
   }
   x.resize(b.size());
-  for (size_t i = 0; i < n; ++i) x.segment<3>(3 * order_[i]) = z[i].head<3>().cast<double>();
+  for (size_t i = 0; i < n; ++i) x.segment<B>(B * order_[i]) = z(i);
+}
+
+void BlockLdlt::precondition(const Eigen::VectorXd &b, Eigen::VectorXd &x) const {
+  if (b_ == 9) precondition_blocks<9, float_rows(9)>(b, x);
+  else precondition_blocks<3, float_rows(3)>(b, x);
+}
+
+namespace {
+
+// The passes of precondition() on z (n blocks of P floats, b's entries
+// gathered into it in the analysed order): forward by rows, so that row k's
+// sum stays in registers (a pass by columns would read and write z once per
+// block); D^-1; backward by columns.
+template <int B, int P>
+inline void precondition_passes(size_t n, const int *row_start, const int *rcol, const float *lrf, const float *df,
+                                const int *col_start, const int *row, const float *lf, float *z) {
+  constexpr size_t FB = B * P;
+  for (size_t k = 0; k < n; ++k) {
+    float acc[P];
+    std::copy(z + k * P, z + k * P + P, acc);
+    for (int e = row_start[k]; e < row_start[k + 1]; ++e)
+      subtract_product<B, P>(acc, lrf + static_cast<size_t>(e) * FB, z + static_cast<size_t>(rcol[e]) * P);
+    std::copy(acc, acc + P, z + k * P);
+  }
+  for (size_t i = 0; i < n; ++i) {
+    float zi[P];
+    std::copy(z + i * P, z + i * P + P, zi);
+    product<B, P>(z + i * P, df + i * FB, zi);
+  }
+  for (size_t i = n; i-- > 0;) {
+    float acc[P];
+    std::copy(z + i * P, z + i * P + P, acc);
+    for (int q = col_start[i]; q < col_start[i + 1]; ++q)
+      subtract_product<B, P>(acc, lf + static_cast<size_t>(q) * FB, z + static_cast<size_t>(row[q]) * P);
+    std::copy(acc, acc + P, z + i * P);
+  }
+}
+
+AFM_KERNEL_CLONES void precondition_passes9(size_t n, const int *row_start, const int *rcol, const float *lrf,
+                                            const float *df, const int *col_start, const int *row, const float *lf,
+                                            float *z) {
+  precondition_passes<9, float_rows(9)>(n, row_start, rcol, lrf, df, col_start, row, lf, z);
+}
+
+}  // namespace
+
+// As solve(), in single precision.
+template <int B, int P>
+void BlockLdlt::precondition_blocks(const Eigen::VectorXd &b, Eigen::VectorXd &x) const {
+  std::vector<float> &z = solve_work_f_;
+  const size_t n = order_.size();
+  z.resize(n * P);
+  for (size_t k = 0; k < n; ++k)
+    for (int r = 0; r < P; ++r) z[k * P + r] = r < B ? static_cast<float>(b[static_cast<Eigen::Index>(B) * order_[k] + r]) : 0.f;
+  if constexpr (B == 9)
+    precondition_passes9(n, row_start_.data(), rcol_.data(), lrf_.data(), df_.data(), col_start_.data(), row_.data(),
+                         lf_.data(), z.data());
+  else
+    precondition_passes<B, P>(n, row_start_.data(), rcol_.data(), lrf_.data(), df_.data(), col_start_.data(),
+                              row_.data(), lf_.data(), z.data());
+  x.resize(b.size());
+  for (size_t i = 0; i < n; ++i)
+    for (int r = 0; r < B; ++r) x[static_cast<Eigen::Index>(B) * order_[i] + r] = z[i * P + r];
 }
 
 }  // namespace afmb

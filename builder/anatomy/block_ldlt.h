@@ -11,6 +11,14 @@
 // ordering is AMD on the nodes). The arithmetic is fixed by the pattern
 // alone (no pivoting, no threads), so results are the same on any run.
 //
+// Pivot groups: analyze(pattern, 3) eliminates three consecutive nodes at a
+// time, as one 9 x 9 block (the tissue's three free nodes of a skin vertex,
+// which share their neighbours: every element couples all nine free nodes
+// of its three vertices). The ordering is then AMD on the groups, and a
+// block of a group's pattern that K lacks (a lip pair couples only the two
+// epidermal nodes) is a stored zero. Mathematically the same factorisation,
+// a block update being 729 multiply-adds per index step instead of 27.
+//
 // The algorithm is the up-looking LDL^T of Davis ("Algorithm 849: a concise
 // sparse Cholesky factorization package", 2005) with blocks for scalars:
 // row k of L solves a sparse triangular system whose pattern is the reach
@@ -42,14 +50,20 @@ class BlockLdlt {
   // Analyses `pattern` (n x n, n = 3 x nodes, both triangles stored, the
   // entries of each column grouped in full blocks: rows 3i, 3i + 1, 3i + 2
   // one after the other, and columns 3j, 3j + 1, 3j + 2 with the same rows):
-  // the nodes' fill-reducing order (AMD on the node graph), the elimination
-  // tree and the pattern of L. Returns false, and stays empty, when the
-  // pattern is not made of such blocks.
-  bool analyze(const SpMat &pattern);
+  // the fill-reducing order (AMD on the graph of the pivot groups), the
+  // elimination tree and the pattern of L. `group`: nodes per pivot block,
+  // 1 or 3 (nodes 3g, 3g + 1, 3g + 2 together; see above). The pattern must
+  // be symmetric. Returns false, and stays empty, when the pattern is not
+  // made of such blocks or the nodes do not divide into groups.
+  // `upper_only`: factorize() reads only K's blocks on and above its
+  // diagonal in the caller's node order (those below may hold anything),
+  // a block below being read as its mirror's transpose.
+  bool analyze(const SpMat &pattern, int group = 1, bool upper_only = false);
 
   // Factorises K, which must have the analysed pattern (the values may be
   // anything, zeros included). Only the blocks on and above the diagonal (in
-  // the analysed order) are read, so K must be symmetric.
+  // the analysed order, or with upper_only their mirrors above K's own
+  // diagonal) are read, so K must be symmetric in them.
   Result factorize(const SpMat &K);
 
   // x = K^-1 b (n each). Only after a factorize() that was not kSingular.
@@ -58,46 +72,56 @@ class BlockLdlt {
   // x ~ K^-1 b in single precision, for preconditioning: float copies of
   // the factors, made by factorize(), L by rows for the forward pass and by
   // columns for the backward one, so that both sum in registers (gathers);
-  // each 3 x 3 block padded to 4 x 3, a block times a vector being three
-  // 4-wide multiply-adds. Two thirds of the memory read by solve(); on
-  // Song's AFM their share of the CPU fell from 19.8 to 16.8 % against
-  // unpadded blocks scattered by columns (perf, one worker).
+  // 3 x 3 blocks padded to 4 x 3, a block times a vector being three 4-wide
+  // multiply-adds (9 x 9 blocks are not padded). Half the memory read by
+  // solve(); with 3 x 3 blocks their share of the CPU of Song's AFM fell
+  // from 19.8 to 16.8 % against unpadded blocks scattered by columns (perf,
+  // one worker).
   void precondition(const Eigen::VectorXd &b, Eigen::VectorXd &x) const;
 
   // The cost model of the solver's refresh rule, in scalar terms: the
   // multiply-adds of a factorisation (sum over L's scalar columns of their
-  // squared lengths) and the nonzeros of the scalar unit lower triangle.
+  // squared lengths) and the nonzeros of the scalar unit lower triangle,
+  // stored zeros of the pivot groups' blocks included.
   double factor_flops() const { return factor_flops_; }
   double nonzeros() const { return nonzeros_; }
 
  private:
-  using M3 = Eigen::Matrix3d;
-  struct UpperBlock {
-    int row;     // block row, in the analysed order (<= the column's)
-    int offset;  // of the block's first entry within each of its column's three scalar columns
+  // A 3 x 3 block of K that lands in an upper block of L's column k.
+  struct Gather {
+    int row;     // block row (pivot group), in the analysed order (<= the column's)
+    int dst;     // offset of the 3 x 3 block's first entry in the b x b block (column-major)
+    int node;    // K's node whose three scalar columns hold it
+    int offset;  // of its first entry within each of those columns
+    bool transpose;  // held as its mirror across K's diagonal (analyze's upper_only)
   };
-  int nodes_ = 0;
-  std::vector<int> order_;     // order_[new] = old node
-  std::vector<int> position_;  // position_[old] = new node
-  std::vector<std::vector<UpperBlock>> upper_;  // per new column: its blocks on and above the diagonal
+  template <int B> Result factorize_blocks(const SpMat &K);
+  template <int B> void solve_blocks(const Eigen::VectorXd &b, Eigen::VectorXd &x) const;
+  template <int B, int P> void precondition_blocks(const Eigen::VectorXd &b, Eigen::VectorXd &x) const;
+
+  int group_ = 1;   // nodes per pivot block
+  int b_ = 3;       // scalars per pivot block, 3 x group_
+  int pad_ = 4;     // the float copies' column length (block_ldlt.cpp, float_rows)
+  int blocks_ = 0;  // pivot groups
+  std::vector<int> order_;     // order_[new] = old group
+  std::vector<int> position_;  // position_[old] = new group
+  std::vector<std::vector<Gather>> upper_;  // per new column: its blocks on and above the diagonal
   std::vector<int> parent_;    // elimination tree, -1 at a root
   std::vector<int> col_start_;  // L's blocks of column i: col_start_[i] .. col_start_[i + 1] - 1
   std::vector<int> row_;       // per L block: its block row
-  std::vector<M3, Eigen::aligned_allocator<M3>> l_, d_inverse_;
-  // Work space of factorize().
-  std::vector<M3, Eigen::aligned_allocator<M3>> y_;
+  // b x b blocks, column-major, one after the other: L's by columns, D^-1 per
+  // group, and the work blocks of factorize().
+  std::vector<double> l_, d_inverse_, y_;
   std::vector<int> flag_, reach_, stack_, filled_;
-  mutable std::vector<Eigen::Vector3d> solve_work_;
-  // precondition()'s factors: 3 x 3 blocks in the top of 4 x 3 (the last
-  // row zero).
-  using M43f = Eigen::Matrix<float, 4, 3>;
-  using V4f = Eigen::Vector4f;
-  std::vector<M43f, Eigen::aligned_allocator<M43f>> lf_;   // per L block (by columns, as l_): its transpose
-  std::vector<M43f, Eigen::aligned_allocator<M43f>> df_;   // per node: d_inverse_
+  mutable std::vector<double> solve_work_;
+  // precondition()'s factors: b columns of pad_ floats per block (the rows
+  // past b zero).
+  std::vector<float> lf_;   // per L block (by columns, as l_): its transpose
+  std::vector<float> df_;   // per group: d_inverse_
   std::vector<int> row_start_;  // L's blocks by rows: row k's are row_start_[k] .. row_start_[k + 1] - 1
   std::vector<int> rcol_;       // per block by rows: its block column
-  std::vector<M43f, Eigen::aligned_allocator<M43f>> lrf_;  // per block by rows: L(k, rcol_)
-  mutable std::vector<V4f, Eigen::aligned_allocator<V4f>> solve_work_f_;
+  std::vector<float> lrf_;      // per block by rows: L(k, rcol_)
+  mutable std::vector<float> solve_work_f_;
   double factor_flops_ = 0, nonzeros_ = 0;
 };
 

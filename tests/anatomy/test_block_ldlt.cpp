@@ -20,15 +20,19 @@ using SpMat = Eigen::SparseMatrix<double>;
 // grid (each node coupled to its 26 neighbours, as the tissue's prisms
 // couple nodes across layers), diagonally dominant by `margin` times the
 // off-diagonal sum: positive definite for margin > 1. Node numbers are
-// shuffled so that the ordering has work to do.
-SpMat grid_matrix(int nx, int ny, int nz, double margin, unsigned seed) {
+// shuffled so that the ordering has work to do. With `columns`, the (x, y)
+// columns are shuffled and each column's nz nodes numbered together, as the
+// solver numbers a skin vertex's tissue nodes.
+SpMat grid_matrix(int nx, int ny, int nz, double margin, unsigned seed, bool columns = false) {
   const int n = nx * ny * nz;
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-1, 1);
-  std::vector<int> label(static_cast<size_t>(n));
-  for (int i = 0; i < n; ++i) label[static_cast<size_t>(i)] = i;
+  std::vector<int> label(static_cast<size_t>(columns ? nx * ny : n));
+  for (size_t i = 0; i < label.size(); ++i) label[i] = static_cast<int>(i);
   std::shuffle(label.begin(), label.end(), rng);
-  auto id = [&](int x, int y, int z) { return label[static_cast<size_t>((z * ny + y) * nx + x)]; };
+  auto id = [&](int x, int y, int z) {
+    return columns ? label[static_cast<size_t>(y * nx + x)] * nz + z : label[static_cast<size_t>((z * ny + y) * nx + x)];
+  };
   Eigen::MatrixXd rowsum = Eigen::MatrixXd::Zero(3 * n, 1);
   std::vector<Eigen::Triplet<double>> t;
   for (int z = 0; z < nz; ++z)
@@ -113,6 +117,103 @@ TEST(BlockLdlt, SolvesAPositiveDefiniteSystemAsADenseCholeskyDoes) {
   // The preconditioner's copies (by rows and by columns) are renewed too.
   f.precondition(b, xf);
   EXPECT_LT((2 * xf - ref).norm(), 1e-5 * ref.norm());
+}
+
+// Pivot groups of three nodes (the solver's: a skin vertex's three free
+// nodes). The grid's node numbers are shuffled, so a group's three nodes lie
+// apart and have different neighbours: its 9 x 9 blocks hold stored zeros
+// where K has no 3 x 3 block. The same solution as one node at a time and as
+// a dense factorisation, on a definite and an indefinite matrix; a singular
+// one is refused.
+TEST(BlockLdlt, PivotGroupsOfThreeNodesSolveTheSameSystems) {
+  const SpMat K = grid_matrix(6, 5, 4, 1.05, 1);
+  const Eigen::VectorXd b = random_vector(K.rows(), 2);
+  const Eigen::VectorXd ref = Eigen::MatrixXd(K).llt().solve(b);
+  BlockLdlt one, three;
+  ASSERT_TRUE(one.analyze(K, 1));
+  ASSERT_TRUE(three.analyze(K, 3));
+  EXPECT_EQ(one.factorize(K), BlockLdlt::Result::kDefinite);
+  EXPECT_EQ(three.factorize(K), BlockLdlt::Result::kDefinite);
+  Eigen::VectorXd x1, x3, xf;
+  one.solve(b, x1);
+  three.solve(b, x3);
+  EXPECT_LT((x3 - ref).norm(), 1e-10 * ref.norm());
+  EXPECT_LT((x3 - x1).norm(), 1e-10 * ref.norm());
+  three.precondition(b, xf);
+  EXPECT_LT((xf - ref).norm(), 1e-5 * ref.norm());
+  // Groups of nodes that are not neighbours fill more (stored zeros
+  // counted). Groups that are (a column of three layers, as the tissue's
+  // vertices): about the fill of one node at a time, and the same solution.
+  EXPECT_GE(three.nonzeros(), one.nonzeros());
+  const SpMat Kc = grid_matrix(9, 8, 3, 1.05, 8, true);
+  ASSERT_TRUE(one.analyze(Kc, 1));
+  ASSERT_TRUE(three.analyze(Kc, 3));
+  EXPECT_LT(three.nonzeros(), 1.25 * one.nonzeros()) << "one node at a time: " << one.nonzeros();
+  EXPECT_EQ(three.factorize(Kc), BlockLdlt::Result::kDefinite);
+  const Eigen::VectorXd bc = random_vector(Kc.rows(), 9);
+  const Eigen::VectorXd refc = Eigen::MatrixXd(Kc).llt().solve(bc);
+  three.solve(bc, x3);
+  EXPECT_LT((x3 - refc).norm(), 1e-10 * refc.norm());
+  three.precondition(bc, xf);
+  EXPECT_LT((xf - refc).norm(), 1e-5 * refc.norm());
+
+  SpMat Ki = grid_matrix(4, 4, 3, 1.05, 3);
+  const Eigen::MatrixXd dense = Eigen::MatrixXd(Ki);
+  const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(dense).eigenvalues();
+  SpMat I(Ki.rows(), Ki.cols());
+  I.setIdentity();
+  Ki = Ki - 0.5 * (ev(ev.size() / 2) + ev(ev.size() / 2 + 1)) * I;
+  ASSERT_TRUE(three.analyze(Ki, 3));
+  EXPECT_EQ(three.factorize(Ki), BlockLdlt::Result::kIndefinite);
+  const Eigen::VectorXd bi = random_vector(Ki.rows(), 4);
+  const Eigen::VectorXd refi = Eigen::MatrixXd(Ki).partialPivLu().solve(bi);
+  three.solve(bi, x3);
+  EXPECT_LT((x3 - refi).norm(), 1e-8 * refi.norm());
+
+  SpMat Ks = grid_matrix(3, 3, 2, 1.05, 5);
+  for (int k = 0; k < Ks.outerSize(); ++k)
+    for (SpMat::InnerIterator it(Ks, k); it; ++it)
+      if (it.row() / 3 == 7 || it.col() / 3 == 7) it.valueRef() = 0;
+  ASSERT_TRUE(three.analyze(Ks, 3));
+  EXPECT_EQ(three.factorize(Ks), BlockLdlt::Result::kSingular);
+
+  // Nodes that do not divide into groups, and a group size not offered.
+  const SpMat K5 = grid_matrix(5, 1, 1, 1.05, 7);
+  EXPECT_FALSE(three.analyze(K5, 3));
+  EXPECT_TRUE(three.analyze(K5, 1));
+  EXPECT_FALSE(three.analyze(K, 2));
+}
+
+// The solver stores its tangent on and above the diagonal only: with
+// upper_only, the blocks below may hold anything and the factors are those
+// of the symmetric matrix the upper blocks make (a block below read as its
+// mirror's transpose; within a pivot group too).
+TEST(BlockLdlt, ReadsOnlyTheUpperTriangleWhenAsked) {
+  const SpMat K = grid_matrix(7, 6, 3, 1.05, 10, true);
+  SpMat junk = K;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-5, 5);
+  for (int k = 0; k < junk.outerSize(); ++k)
+    for (SpMat::InnerIterator it(junk, k); it; ++it)
+      if (it.row() / 3 > it.col() / 3) it.valueRef() = u(rng);
+  const Eigen::VectorXd b = random_vector(K.rows(), 12);
+  const Eigen::VectorXd ref = Eigen::MatrixXd(K).llt().solve(b);
+  for (int group : {1, 3}) {
+    BlockLdlt f;
+    ASSERT_TRUE(f.analyze(junk, group, true));
+    EXPECT_EQ(f.factorize(junk), BlockLdlt::Result::kDefinite) << "group " << group;
+    Eigen::VectorXd x, xf;
+    f.solve(b, x);
+    EXPECT_LT((x - ref).norm(), 1e-10 * ref.norm()) << "group " << group;
+    f.precondition(b, xf);
+    EXPECT_LT((xf - ref).norm(), 1e-5 * ref.norm()) << "group " << group;
+    // Without upper_only the junk is read, and the solution is another.
+    ASSERT_TRUE(f.analyze(junk, group, false));
+    if (f.factorize(junk) != BlockLdlt::Result::kSingular) {
+      f.solve(b, x);
+      EXPECT_GT((x - ref).norm(), 1e-3 * ref.norm()) << "group " << group;
+    }
+  }
 }
 
 TEST(BlockLdlt, SaysWhenTheMatrixIsIndefiniteAndStillSolvesIt) {
