@@ -134,9 +134,7 @@ bool BlockLdlt::analyze(const SpMat &pattern, int group, bool upper_only) {
   g.setFromTriplets(graph.begin(), graph.end());  // repeats summed: the pattern is what counts
   Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> amd;
   Eigen::AMDOrdering<int>()(g, amd);
-  group_ = group;
   b_ = 3 * group;
-  pad_ = float_rows(b_);
   blocks_ = groups;
   order_.assign(amd.indices().data(), amd.indices().data() + groups);
   position_.assign(static_cast<size_t>(groups), 0);
@@ -190,7 +188,7 @@ bool BlockLdlt::analyze(const SpMat &pattern, int group, bool upper_only) {
     nonzeros_ += b_ * b_ * c + b_ * (b_ - 1) / 2.0;
   }
   const size_t blocks = static_cast<size_t>(col_start_.back()), bb = static_cast<size_t>(b_ * b_),
-               fb = static_cast<size_t>(b_ * pad_);
+               fb = static_cast<size_t>(b_ * float_rows(b_));
   row_.assign(blocks, 0);
   l_.assign(blocks * bb, 0.0);
   d_inverse_.assign(static_cast<size_t>(groups) * bb, 0.0);

@@ -99,9 +99,7 @@ class BlockLdlt {
   template <int B> void solve_blocks(const Eigen::VectorXd &b, Eigen::VectorXd &x) const;
   template <int B, int P> void precondition_blocks(const Eigen::VectorXd &b, Eigen::VectorXd &x) const;
 
-  int group_ = 1;   // nodes per pivot block
-  int b_ = 3;       // scalars per pivot block, 3 x group_
-  int pad_ = 4;     // the float copies' column length (block_ldlt.cpp, float_rows)
+  int b_ = 3;       // scalars per pivot block, 3 x the nodes in it
   int blocks_ = 0;  // pivot groups
   std::vector<int> order_;     // order_[new] = old group
   std::vector<int> position_;  // position_[old] = new group
@@ -114,8 +112,8 @@ class BlockLdlt {
   std::vector<double> l_, d_inverse_, y_;
   std::vector<int> flag_, reach_, stack_, filled_;
   mutable std::vector<double> solve_work_;
-  // precondition()'s factors: b columns of pad_ floats per block (the rows
-  // past b zero).
+  // precondition()'s factors: b columns of float_rows(b) floats per block
+  // (block_ldlt.cpp; the rows past b zero).
   std::vector<float> lf_;   // per L block (by columns, as l_): its transpose
   std::vector<float> df_;   // per group: d_inverse_
   std::vector<int> row_start_;  // L's blocks by rows: row k's are row_start_[k] .. row_start_[k + 1] - 1
