@@ -1306,6 +1306,24 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
   for (int v = 0; v < skin.n; ++v)
     if (skin.eye_near[static_cast<size_t>(v)] >= 0) held[static_cast<size_t>(v)] = kUntangleHeld;
   std::vector<RigidSample> jaw_samples;
+  // Reach, then hold (fap_synthesis.h): the sides that store an
+  // under-reaching pose twice.
+  std::vector<char> negative_made(AFM_FAP_COUNT + 1, 0);
+  for (size_t k = 0; k < work.size(); ++k)
+    if (work[k].fap && work[k].side < 0 && results[k].target) negative_made[static_cast<size_t>(work[k].fap->fap)] = 1;
+  auto holds_reach = [&](size_t k) {
+    const Work &w = work[k];
+    const FapOutcome &o = results[k].outcome;
+    if (!options.hold_reach || !w.fap || w.in_between || w.fap->driver != FapDriver::Muscles || w.fap->lid ||
+        !results[k].target || !o.made || o.reached >= 1)
+      return false;
+    // Negative values would extrapolate the positive side's first segment.
+    if (w.side > 0 && afm_fap(w.fap->fap)->bidirectional && !negative_made[static_cast<size_t>(w.fap->fap)])
+      return false;
+    for (size_t j = 0; j < work.size(); ++j)
+      if (j != k && work[j].fap == w.fap && work[j].side == w.side && results[j].target) return false;
+    return true;
+  };
   for (size_t k = 0; k < results.size(); ++k) {
     Result &r = results[k];
     if (r.target && r.target->displacement[static_cast<size_t>(model.skin)].rows() == 0) {
@@ -1331,6 +1349,38 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       const SkinFaults faults = skin_faults(model, rest + D);
       r.outcome.turned = static_cast<int>(faults.turned_faces.size());
       r.outcome.sunk = static_cast<int>(faults.sunk_vertices.size());
+      if (holds_reach(k)) {
+        // The pose scaled to the whole FAP units it reaches along the FAP's
+        // direction, r = floor(a), as the side's target at r.
+        FapOutcome &o = r.outcome;
+        const Eigen::Vector3d dir = fap_direction(afm_fap(o.number));
+        const int table = work[k].reference;
+        const double a = table * o.achieved.dot(dir) / o.prescribed.dot(dir);
+        const int reach = static_cast<int>(std::floor(a));
+        if (reach >= 1 && a < table) {
+          const double c = reach / a;
+          MorphTarget base = t;
+          for (Eigen::MatrixXd &d : base.displacement) d *= c;
+          base.reference = o.side * reach;
+          FapOutcome b = o;
+          b.reference = base.reference;
+          b.prescribed = o.prescribed * (static_cast<double>(reach) / table);
+          measure(b, c * o.achieved, dir);
+          b.reached = 1;
+          const SkinFaults bf = skin_faults(model, rest + base.displacement[static_cast<size_t>(model.skin)]);
+          b.turned = static_cast<int>(bf.turned_faces.size());
+          b.sunk = static_cast<int>(bf.sunk_vertices.size());
+          b.message = "its group's reach, " + std::to_string(reach) + " of the table's " + std::to_string(table) +
+                      "; held to " + std::to_string(o.side * table) + " (the in-between there)";
+          out.targets.push_back(std::move(base));
+          out.outcomes.push_back(std::move(b));
+          // The pose as it is, at the table's reference.
+          o.in_between = true;
+          o.holds = true;
+          o.seconds = 0;
+          o.message = "holds the reach of " + std::to_string(o.side * reach) + "; " + o.message;
+        }
+      }
       out.targets.push_back(std::move(t));
     }
     if (r.outcome.made) jaw_samples.insert(jaw_samples.end(), r.jaw.begin(), r.jaw.end());

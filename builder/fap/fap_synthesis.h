@@ -98,13 +98,27 @@
 // chord between the two poses keeps the skin a face; not for a group that
 // moves its FDP less than a FAP unit at s = 1); failing that, the pose at
 // s = 1. A group that cannot reach the reference makes
-// its target at that cap and keeps the table's reference: the target
-// under-reaches (the outcome says by how much and why), and a stream at the
-// reference shows the muscles at their most. (Lowering the reference to
-// what the group reaches kept the MPEG-4 rule exact, but real streams then
-// extrapolated small targets up to 90 times and tore the face.) A group
-// that moves its FDP the wrong way, or by less than a FAP unit, gets no
-// target.
+// its target at that cap: the target under-reaches (the outcome says by how
+// much and why). A group that moves its FDP the wrong way, or by less than a
+// FAP unit, gets no target.
+//
+// Reach, then hold. An under-reaching side's pose is stored twice: scaled
+// to the whole FAP units it reaches, r = floor(reached x reference), as the
+// side's target at r, and as it is, as an in-between at the table's
+// reference (FapOutcome::holds). The player blends a side's targets
+// piecewise linearly (formats/afm.md), so a value up to r moves the FDP by
+// value x FAPU, as MPEG-4 says, and past r the face holds the group's most
+// (it grows by the floor's rounding up to the reference, and past the
+// reference goes on at that slope). Stored once at the table's reference,
+// as before, every value moved the FDP by `reached` of its prescription:
+// Song's chin raised (FAP 18) by 28 % of what a stream asked at any value.
+// (Stored once at r, a stream's values past it extrapolated the pose: real
+// streams then took small targets up to 90 times and tore the face.) Not
+// held: a positive side whose negative values would extrapolate it (a
+// bidirectional FAP without a negative-side target), the jaw's and the
+// lids' FAPs, and a side with in-betweens of its own.
+// FapSynthesisOptions::hold_reach = false stores the pose once, at the
+// table's reference.
 //
 // Helpers (steer.h; FapMapping::helpers): where a group's pose, at the
 // value or at its cap, moves the FDP off the FAP's direction by more than
@@ -143,7 +157,10 @@ struct FapOutcome {
   int number = 0;                 // FAP 3..68, viseme 1..14 or expression 1..6, after `kind`
   int side = +1;                  // +1: the positive reference, -1: the negative one
   int reference = 0;              // signed FAP units (63 for visemes and expressions)
-  bool in_between = false;        // one of FapMapping::farther (made only where reached in full)
+  bool in_between = false;        // one of FapMapping::farther (made only where reached in full),
+                                  // or a hold
+  bool holds = false;             // an in-between at the table's reference holding an
+                                  // under-reaching side's pose ("Reach, then hold")
   bool made = false;              // a target was made
   std::string message;            // why not, when !made; how far it reaches when it under-reaches
   double reached = 1;             // the achieved share of the prescribed motion along the
@@ -189,6 +206,10 @@ struct FapSynthesisOptions {
   // Let helpers steer a group's FDP back onto the FAP's direction (steer.h);
   // false: the table's groups act alone.
   bool steer = true;
+  // Store an under-reaching side's pose at the FAP units it reaches and hold
+  // it to the table's reference ("Reach, then hold"); false: once, at the
+  // table's reference.
+  bool hold_reach = true;
   // Workers (0: one per core). The targets are the same for any number.
   int threads = 0;
   // The simulation mesh the model was built on (sim_mesh.h), when it is

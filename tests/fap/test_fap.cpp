@@ -7,6 +7,7 @@
 #include <afm/draco.h>
 #include <afm/format.h>
 #include <afm/mpeg4.h>
+#include <afm/player.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
@@ -432,7 +433,8 @@ TEST(Steer, TheChoiceCancelsTheOffAxisMotionWithinItsBoundsAndTheSecantMeetsWhat
 
 // FAP `fap`'s positive target on the 1k head, made alone, with the helpers
 // steering (fap/steer.h) or without; `made` false, with a test failure,
-// when it is not made.
+// when it is not made. An under-reaching pose is stored once, at the
+// table's reference (no hold: fap_synthesis.h, "Reach, then hold").
 struct Solo {
   bool made = false;
   FapOutcome outcome;
@@ -443,6 +445,7 @@ Solo solo_target(int fap, bool steer) {
   o.only = {fap};
   o.negative_sides = false;
   o.steer = steer;
+  o.hold_reach = false;
   Expected<FapSynthesis> r = synthesize_faps(head_1k().head.scene, head_1k().model, o);
   EXPECT_TRUE(r.is_ok()) << r.status().message();
   Solo out;
@@ -2287,6 +2290,119 @@ TEST(FapSynthesis, TheAfmHoldsTheTargetsAndTheJaw) {
             r.controls[k].knot == s.jaw.controls[k].knot;
   }
   EXPECT_TRUE(jaw);
+}
+
+// The motion along `dir` (model units) of FDP group.index in `doc`, played by
+// the player at each of `values` of FAP `fap` (the other FAPs at 0).
+std::vector<double> played_along(const afm_doc &doc, int group, int index, const Eigen::Vector3d &dir, int fap,
+                                 const std::vector<int> &values) {
+  std::vector<double> out;
+  uint32_t v = AFM_NONE;
+  for (uint32_t i = 0; i < doc.meta.fdp_count; ++i)
+    if (doc.meta.fdps[i].group == group && doc.meta.fdps[i].index == index) v = doc.meta.fdps[i].vertex;
+  EXPECT_NE(v, AFM_NONE);
+  size_t bytes = 0;
+  EXPECT_EQ(afm_player_measure(&doc, nullptr, &bytes), AFM_OK);
+  std::vector<uint64_t> buffer(bytes / 8 + 1);
+  afm_player *player = nullptr;
+  EXPECT_EQ(afm_player_init(&doc, nullptr, buffer.data(), buffer.size() * 8, &player), AFM_OK);
+  if (v == AFM_NONE || !player) return out;
+  const afm_geometry &g = doc.geometry;
+  for (int value : values) {
+    afm_fap_state state;
+    afm_fap_state_reset(&state);
+    state.value[fap] = value;
+    EXPECT_EQ(afm_player_pose(player, &state, nullptr, 0), AFM_OK);
+    const int32_t *x = afm_player_positions(player);
+    const Eigen::Vector3d d(x[3 * v] - g.px[v], x[3 * v + 1] - g.py[v], x[3 * v + 2] - g.pz[v]);
+    out.push_back(g.step * d.dot(dir));
+  }
+  return out;
+}
+
+// Reach, then hold (fap_synthesis.h). Mentalis moves the 1k head's chin
+// (FAP 18) by a share of its reference, either way, before the skin folds.
+// Each side's pose is then stored at the whole FAP units it reaches, and
+// held from there to the reference. Played from the encoded AFM, the chin
+// moves by value x FAPU (the MPEG-4 table and the FAPU, not the report) up
+// to the reach, and hardly further past it; stored once at the reference,
+// it moved by that share of every value.
+TEST(FapSynthesis, AnUnderReachingSideMovesItsFdpByTheValueUpToItsReachAndHoldsThere) {
+  const Built &b = head_1k();
+  const FaceModel &m = b.model;
+  FapSynthesisOptions o;
+  o.only = {18};
+  Expected<FapSynthesis> held = synthesize_faps(b.head.scene, m, o);
+  o.hold_reach = false;
+  Expected<FapSynthesis> once = synthesize_faps(b.head.scene, m, o);
+  ASSERT_TRUE(held.is_ok()) << held.status().message();
+  ASSERT_TRUE(once.is_ok()) << once.status().message();
+  ASSERT_EQ(once->targets.size(), 2u);  // a side each, at +-300
+  ASSERT_EQ(held->targets.size(), 4u);  // a side each, at the reach and held at +-300
+  const afm_fap_info *info = afm_fap(18);
+  const Eigen::Vector3d dir = direction_of(18);
+  const double unit = fapu_distance(m.fapu, info->unit) / 1024.0;
+  const FdpPoint *fdp = m.fdps.find(FdpId{info->fdp_group, info->fdp_index}, m.skin);
+  ASSERT_TRUE(fdp && fdp->vertex >= 0);
+  const size_t skin = static_cast<size_t>(m.skin);
+  auto find = [](const FapSynthesis &syn, int reference) -> std::pair<const MorphTarget *, const FapOutcome *> {
+    const MorphTarget *t = nullptr;
+    const FapOutcome *out = nullptr;
+    for (const MorphTarget &k : syn.targets)
+      if (k.number == 18 && k.reference == reference) t = &k;
+    for (const FapOutcome &k : syn.outcomes)
+      if (k.number == 18 && k.made && k.reference == reference) out = &k;
+    return {t, out};
+  };
+  const DocPtr held_doc = encoded_doc(fap_afm_content(b.head.scene, b.head.fdps, m, *held));
+  const DocPtr once_doc = encoded_doc(fap_afm_content(b.head.scene, b.head.fdps, m, *once));
+  ASSERT_TRUE(held_doc && once_doc);
+  const double quantum = held_doc->geometry.step;
+  for (int side : {+1, -1}) {
+    SCOPED_TRACE(side > 0 ? "positive" : "negative");
+    const auto [alone, alone_outcome] = find(*once, side * 300);
+    const auto [hold, hold_outcome] = find(*held, side * 300);
+    ASSERT_TRUE(alone && hold && alone_outcome && hold_outcome);
+    // The hold is the pose stored once, as it is.
+    EXPECT_EQ(hold->displacement[skin], alone->displacement[skin]);
+    EXPECT_TRUE(hold_outcome->holds && hold_outcome->in_between);
+    EXPECT_LT(hold_outcome->reached, 1);
+    // a: the FAP units the pose reaches along the direction.
+    const double a = side * alone->displacement[skin].row(fdp->vertex).dot(dir) / unit;
+    ASSERT_GT(a, 1);
+    ASSERT_LT(a, 300);
+    const int reach = static_cast<int>(std::floor(a));
+    const auto [base, base_outcome] = find(*held, side * reach);
+    ASSERT_TRUE(base && base_outcome) << "no target at " << side * reach;
+    EXPECT_FALSE(base_outcome->holds || base_outcome->in_between);
+    EXPECT_EQ(base_outcome->reached, 1);
+    EXPECT_LT(base_outcome->along_error, 1e-9);
+    EXPECT_LT((base->displacement[skin] - alone->displacement[skin] * (reach / a)).cwiseAbs().maxCoeff(), 1e-12);
+
+    // Played: within the reach by the value; past it between the reach and
+    // the pose's whole motion, growing by the floor's rounding.
+    const std::vector<int> values = {side * reach / 2, side * reach, side * (reach + 300) / 2, side * 300,
+                                     side * 600};
+    const std::vector<double> h = played_along(*held_doc, info->fdp_group, info->fdp_index, dir, 18, values);
+    const std::vector<double> l = played_along(*once_doc, info->fdp_group, info->fdp_index, dir, 18, values);
+    ASSERT_EQ(h.size(), values.size());
+    ASSERT_EQ(l.size(), values.size());
+    const double slack = 3 * quantum;
+    for (size_t i = 0; i < values.size(); ++i) {
+      const double v = values[i] * unit;  // the MPEG-4 rule, signed
+      std::printf("FAP 18 at %4d: the chin moves %+6.1f FAP units held, %+6.1f stored once (a quantum %.2f)\n",
+                  values[i], h[i] / unit, l[i] / unit, quantum / unit);
+      // Stored once, the pose is a straight line through the reach at 300.
+      EXPECT_NEAR(l[i], v * a / 300, slack);
+      if (std::abs(values[i]) <= reach) {
+        EXPECT_NEAR(h[i], v, slack);
+      } else {
+        const double grown = (a - reach) * (std::abs(values[i]) - reach) / (300 - reach);
+        EXPECT_GE(side * h[i], reach * unit - slack);
+        EXPECT_LE(side * h[i], (reach + grown) * unit + slack);
+      }
+    }
+  }
 }
 
 }  // namespace
