@@ -1367,6 +1367,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
           b.prescribed = o.prescribed * (static_cast<double>(reach) / table);
           measure(b, c * o.achieved, dir);
           b.reached = 1;
+          b.at_reach = true;
           const SkinFaults bf = skin_faults(model, rest + base.displacement[static_cast<size_t>(model.skin)]);
           b.turned = static_cast<int>(bf.turned_faces.size());
           b.sunk = static_cast<int>(bf.sunk_vertices.size());

@@ -161,6 +161,7 @@ struct FapOutcome {
                                   // or a hold
   bool holds = false;             // an in-between at the table's reference holding an
                                   // under-reaching side's pose ("Reach, then hold")
+  bool at_reach = false;          // that side's target at the FAP units it reaches
   bool made = false;              // a target was made
   std::string message;            // why not, when !made; how far it reaches when it under-reaches
   double reached = 1;             // the achieved share of the prescribed motion along the

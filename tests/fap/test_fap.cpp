@@ -2403,6 +2403,25 @@ TEST(FapSynthesis, AnUnderReachingSideMovesItsFdpByTheValueUpToItsReachAndHoldsT
       }
     }
   }
+
+  // The report's summary counts each side once, at the table's reference:
+  // the figures are those of the pose stored once. The targets at the reach
+  // have their off-axis median apart, against their own motion.
+  auto figures = [](const std::string &table) {
+    const size_t from = table.find("FAPs along the direction"), to = table.find(" of the prescribed motion", from);
+    return from == std::string::npos || to == std::string::npos ? std::string() : table.substr(from, to - from);
+  };
+  const std::string held_table = fidelity_table(*held), once_table = fidelity_table(*once);
+  EXPECT_FALSE(figures(once_table).empty()) << once_table;
+  EXPECT_EQ(figures(held_table), figures(once_table));
+  std::vector<double> at_reach;
+  for (const FapOutcome &k : held->outcomes)
+    if (k.at_reach) at_reach.push_back(k.off_axis);
+  ASSERT_EQ(at_reach.size(), 2u);
+  char apart[96];
+  std::snprintf(apart, sizeof apart, "2 of them held past a target at their reach, whose off-axis median is %.1f%%",
+                100 * std::max(at_reach[0], at_reach[1]));
+  EXPECT_NE(held_table.find(apart), std::string::npos) << apart << "\n" << held_table;
 }
 
 }  // namespace
