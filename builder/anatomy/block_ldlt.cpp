@@ -305,8 +305,8 @@ void BlockLdlt::solve_blocks(const Eigen::VectorXd &b, Eigen::VectorXd &x) const
 }
 
 void BlockLdlt::precondition(const Eigen::VectorXd &b, Eigen::VectorXd &x) const {
-  if (b_ == 9) precondition_blocks<9, float_rows(9)>(b, x);
-  else precondition_blocks<3, float_rows(3)>(b, x);
+  if (b_ == 9) precondition_blocks<9>(b, x);
+  else precondition_blocks<3>(b, x);
 }
 
 namespace {
@@ -349,8 +349,9 @@ AFM_KERNEL_CLONES void precondition_passes9(size_t n, const int *row_start, cons
 }  // namespace
 
 // As solve(), in single precision.
-template <int B, int P>
+template <int B>
 void BlockLdlt::precondition_blocks(const Eigen::VectorXd &b, Eigen::VectorXd &x) const {
+  constexpr int P = float_rows(B);
   std::vector<float> &z = solve_work_f_;
   const size_t n = order_.size();
   z.resize(n * P);

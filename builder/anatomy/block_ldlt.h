@@ -47,13 +47,14 @@ class BlockLdlt {
     kSingular,    // a D block is singular or not finite: nothing to solve with
   };
 
-  // Analyses `pattern` (n x n, n = 3 x nodes, both triangles stored, the
-  // entries of each column grouped in full blocks: rows 3i, 3i + 1, 3i + 2
+  // Analyses `pattern` (n x n, n = 3 x nodes, both triangles stored, or
+  // with upper_only the upper one alone; the entries of each column grouped in
+  // full blocks: rows 3i, 3i + 1, 3i + 2
   // one after the other, and columns 3j, 3j + 1, 3j + 2 with the same rows):
   // the fill-reducing order (AMD on the graph of the pivot groups), the
   // elimination tree and the pattern of L. `group`: nodes per pivot block,
-  // 1 or 3 (nodes 3g, 3g + 1, 3g + 2 together; see above). The pattern must
-  // be symmetric. Returns false, and stays empty, when the pattern is not
+  // 1 or 3 (nodes 3g, 3g + 1, 3g + 2 together; see above). Without
+  // upper_only the pattern must be symmetric. Returns false, and stays empty, when the pattern is not
   // made of such blocks or the nodes do not divide into groups.
   // `upper_only`: factorize() reads only K's blocks on and above its
   // diagonal in the caller's node order (those below may hold anything),
@@ -97,7 +98,7 @@ class BlockLdlt {
   };
   template <int B> Result factorize_blocks(const SpMat &K);
   template <int B> void solve_blocks(const Eigen::VectorXd &b, Eigen::VectorXd &x) const;
-  template <int B, int P> void precondition_blocks(const Eigen::VectorXd &b, Eigen::VectorXd &x) const;
+  template <int B> void precondition_blocks(const Eigen::VectorXd &b, Eigen::VectorXd &x) const;
 
   int b_ = 3;       // scalars per pivot block, 3 x the nodes in it
   int blocks_ = 0;  // pivot groups

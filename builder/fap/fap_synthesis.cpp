@@ -1324,6 +1324,39 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       if (j != k && work[j].fap == w.fap && work[j].side == w.side && results[j].target) return false;
     return true;
   };
+  // The held side's target at its reach: pose t scaled to the whole FAP
+  // units it reaches along the FAP's direction, r = floor(a), stored at r
+  // (into `out`, before the hold); outcome o becomes the hold's. Nothing
+  // where it reaches under one unit.
+  auto split_hold = [&](size_t k, const MorphTarget &t, FapOutcome &o) {
+    const Eigen::Vector3d dir = fap_direction(afm_fap(o.number));
+    const int table = work[k].reference;
+    const double a = table * o.achieved.dot(dir) / o.prescribed.dot(dir);
+    const int reach = static_cast<int>(std::floor(a));
+    if (reach < 1 || a >= table) return;
+    const double c = reach / a;
+    MorphTarget base = t;
+    for (Eigen::MatrixXd &d : base.displacement) d *= c;
+    base.reference = o.side * reach;
+    FapOutcome b = o;
+    b.reference = base.reference;
+    b.prescribed = o.prescribed * (static_cast<double>(reach) / table);
+    measure(b, c * o.achieved, dir);
+    b.reached = 1;
+    b.at_reach = true;
+    const SkinFaults bf = skin_faults(model, rest + base.displacement[static_cast<size_t>(model.skin)]);
+    b.turned = static_cast<int>(bf.turned_faces.size());
+    b.sunk = static_cast<int>(bf.sunk_vertices.size());
+    b.message = "its group's reach, " + std::to_string(reach) + " of the table's " + std::to_string(table) +
+                "; held to " + std::to_string(o.side * table) + " (the in-between there)";
+    out.targets.push_back(std::move(base));
+    out.outcomes.push_back(std::move(b));
+    // The pose as it is, at the table's reference.
+    o.in_between = true;
+    o.holds = true;
+    o.seconds = 0;
+    o.message = "holds the reach of " + std::to_string(o.side * reach) + "; " + o.message;
+  };
   for (size_t k = 0; k < results.size(); ++k) {
     Result &r = results[k];
     if (r.target && r.target->displacement[static_cast<size_t>(model.skin)].rows() == 0) {
@@ -1349,39 +1382,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       const SkinFaults faults = skin_faults(model, rest + D);
       r.outcome.turned = static_cast<int>(faults.turned_faces.size());
       r.outcome.sunk = static_cast<int>(faults.sunk_vertices.size());
-      if (holds_reach(k)) {
-        // The pose scaled to the whole FAP units it reaches along the FAP's
-        // direction, r = floor(a), as the side's target at r.
-        FapOutcome &o = r.outcome;
-        const Eigen::Vector3d dir = fap_direction(afm_fap(o.number));
-        const int table = work[k].reference;
-        const double a = table * o.achieved.dot(dir) / o.prescribed.dot(dir);
-        const int reach = static_cast<int>(std::floor(a));
-        if (reach >= 1 && a < table) {
-          const double c = reach / a;
-          MorphTarget base = t;
-          for (Eigen::MatrixXd &d : base.displacement) d *= c;
-          base.reference = o.side * reach;
-          FapOutcome b = o;
-          b.reference = base.reference;
-          b.prescribed = o.prescribed * (static_cast<double>(reach) / table);
-          measure(b, c * o.achieved, dir);
-          b.reached = 1;
-          b.at_reach = true;
-          const SkinFaults bf = skin_faults(model, rest + base.displacement[static_cast<size_t>(model.skin)]);
-          b.turned = static_cast<int>(bf.turned_faces.size());
-          b.sunk = static_cast<int>(bf.sunk_vertices.size());
-          b.message = "its group's reach, " + std::to_string(reach) + " of the table's " + std::to_string(table) +
-                      "; held to " + std::to_string(o.side * table) + " (the in-between there)";
-          out.targets.push_back(std::move(base));
-          out.outcomes.push_back(std::move(b));
-          // The pose as it is, at the table's reference.
-          o.in_between = true;
-          o.holds = true;
-          o.seconds = 0;
-          o.message = "holds the reach of " + std::to_string(o.side * reach) + "; " + o.message;
-        }
-      }
+      if (holds_reach(k)) split_hold(k, t, r.outcome);
       out.targets.push_back(std::move(t));
     }
     if (r.outcome.made) jaw_samples.insert(jaw_samples.end(), r.jaw.begin(), r.jaw.end());

@@ -1,9 +1,10 @@
 /* Rigid parts: eyeballs, jaw and head turn about their pivots (RIGD chunk).
  *
  * Motion of a degree of freedom = sum of FAP value (its part beyond the
- * control's knot) x gain (Q16.16): AU for rotations, quanta for translations. Rotation R = A^T Ry Rx Rz A with A the
- * rigid's local axes as rows (Q14) and the three axis rotations from integer
- * sines; p' = R p + t with t = pivot - R pivot + A^T translation.
+ * control's knot) x gain (Q16.16): AU for rotations, quanta for
+ * translations. Rotation R = A^T Ry Rx Rz A with A the rigid's local axes as
+ * rows (Q14) and the three axis rotations from integer sines; p' = R p + t
+ * with t = pivot - R pivot + A^T translation.
  *
  * Ranges: init checks that axes are orthonormal within 2 % and pivots lie
  * within 2^24 quanta; translations are clamped to 2^24. Positions then stay

@@ -2418,6 +2418,7 @@ TEST(FapSynthesis, AnUnderReachingSideMovesItsFdpByTheValueUpToItsReachAndHoldsT
   for (const FapOutcome &k : held->outcomes)
     if (k.at_reach) at_reach.push_back(k.off_axis);
   ASSERT_EQ(at_reach.size(), 2u);
+  // The median of two, as the report takes it (the upper one).
   char apart[96];
   std::snprintf(apart, sizeof apart, "2 of them held past a target at their reach, whose off-axis median is %.1f%%",
                 100 * std::max(at_reach[0], at_reach[1]));
