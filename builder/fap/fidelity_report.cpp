@@ -161,12 +161,17 @@ std::string fidelity_table(const FapSynthesis &s) {
   }
   out += format("targets: %zu made, %d not made; FAPs along the direction median %.2f%% worst %.2f%%; off-axis "
                 "median %.1f%% worst %.1f%% (across the face median %.1f%%, in depth %.1f%%); %zu under-reach "
-                "(median %.0f%% of the prescribed motion; %d of them held past a target at their reach, whose "
-                "off-axis median is %.1f%% of its own motion); %d turn %d skin triangles over (visemes and "
+                "(median %.0f%% of the prescribed motion%s); %d turn %d skin triangles over (visemes and "
                 "expressions: achieved = largest motion)%s%s\n",
                 s.targets.size(), failed, 100 * median(along), 100 * worst(along), 100 * median(off),
                 100 * worst(off), 100 * median(off_face), 100 * median(off_depth), reach.size(),
-                100 * median(reach), holds, 100 * median(off_at_reach), turning, turned,
+                100 * median(reach),
+                holds ? format("; %d of them held past a target at their reach, whose off-axis median is %.1f%% "
+                               "of its own motion",
+                               holds, 100 * median(off_at_reach))
+                            .c_str()
+                      : "",
+                turning, turned,
                 sinking ? format("; %d sink skin below the skull", sinking).c_str() : "",
                 kinematic ? format("; %d targets of the tongue and pupils are exact by construction and not in "
                                    "these figures",

@@ -41,8 +41,8 @@ std::string target_label(const FapOutcome &outcome);
 // median and worst error along the direction and off it, and the medians of
 // the off-axis parts across the face and in depth. Each FAP side counts once,
 // at the table's reference: a held side (fap_synthesis.h, "Reach, then
-// hold") by its hold; the off-axis median of the targets at the reach, against
-// their own motion, is given apart.
+// hold") by its hold; where there are holds, the off-axis median of the
+// targets at the reach, against their own motion, is given apart.
 std::string fidelity_table(const FapSynthesis &synthesis);
 
 struct FidelityReportOptions {

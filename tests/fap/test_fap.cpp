@@ -2423,6 +2423,8 @@ TEST(FapSynthesis, AnUnderReachingSideMovesItsFdpByTheValueUpToItsReachAndHoldsT
   std::snprintf(apart, sizeof apart, "2 of them held past a target at their reach, whose off-axis median is %.1f%%",
                 100 * std::max(at_reach[0], at_reach[1]));
   EXPECT_NE(held_table.find(apart), std::string::npos) << apart << "\n" << held_table;
+  // Without holds the summary says nothing of them.
+  EXPECT_EQ(once_table.find("held past"), std::string::npos) << once_table;
 }
 
 }  // namespace
