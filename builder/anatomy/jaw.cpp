@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <queue>
 
 #include "anatomy/muscles.h"
+#include "core/edge_paths.h"
 #include "core/ray_triangle.h"
 
 namespace afmb {
@@ -102,22 +102,11 @@ Expected<Jaw> build_jaw(const SkinModel &skin, const FdpSet &fdps, const Fapu &f
     return x1 > x0 ? y0 + (y1 - y0) * (x - x0) / (x1 - x0) : std::min(y0, y1);
   };
   const double band = kJawFollowBand * fapu.mw0;
-  std::vector<double> dist(static_cast<size_t>(skin.n), band);
-  using Item = std::pair<double, int>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> front;
-  for (int v : jaw.vertices) dist[static_cast<size_t>(v)] = 0, front.push({0.0, v});
-  while (!front.empty()) {
-    const auto [d, v] = front.top();
-    front.pop();
-    if (d > dist[static_cast<size_t>(v)]) continue;
-    for (int u : skin.neighbours[static_cast<size_t>(v)]) {
-      if (!skin.in_mesh[static_cast<size_t>(u)] || std::binary_search(upper.begin(), upper.end(), u) ||
-          skin.X0(u, 1) >= line_y(skin.X0(u, 0)))
-        continue;
-      const double du = d + (skin.X0.row(u) - skin.X0.row(v)).norm();
-      if (du < dist[static_cast<size_t>(u)]) dist[static_cast<size_t>(u)] = du, front.push({du, u});
-    }
-  }
+  const std::vector<double> dist =
+      edge_path_distances(skin.X0, skin.neighbours, jaw.vertices, band, [&](int u) {
+        return skin.in_mesh[static_cast<size_t>(u)] && !std::binary_search(upper.begin(), upper.end(), u) &&
+               skin.X0(u, 1) < line_y(skin.X0(u, 0));
+      });
   for (int v = 0; v < skin.n; ++v) {
     const double d = dist[static_cast<size_t>(v)];
     if (d > 0 && d < band) jaw.followers.emplace_back(v, 0.5 * (1 + std::cos(3.14159265358979323846 * d / band)));

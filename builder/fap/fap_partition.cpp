@@ -3,43 +3,14 @@
 #include <algorithm>
 #include <limits>
 #include <numeric>
-#include <queue>
+
+#include "core/edge_paths.h"
 
 namespace afmb {
 
-namespace {
-
-// Path lengths over the mesh's edges from vertex `from` (Dijkstra), #V:
-// across the mouth the lips are far apart even where they touch.
-Eigen::VectorXd path_distances(const Eigen::MatrixXd &X, const std::vector<std::vector<int>> &adj, int from) {
-  Eigen::VectorXd d = Eigen::VectorXd::Constant(X.rows(), std::numeric_limits<double>::infinity());
-  using Item = std::pair<double, int>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> q;
-  d(from) = 0;
-  q.push({0.0, from});
-  while (!q.empty()) {
-    const auto [dv, v] = q.top();
-    q.pop();
-    if (dv > d(v)) continue;
-    for (int w : adj[static_cast<size_t>(v)]) {
-      const double dw = dv + (X.row(v) - X.row(w)).norm();
-      if (dw < d(w)) d(w) = dw, q.push({dw, w});
-    }
-  }
-  return d;
-}
-
-}  // namespace
-
 FapPartition partition_shared_targets(const Eigen::MatrixXd &X, const Eigen::MatrixXi &F,
                                       const std::vector<SharingTarget> &targets) {
-  std::vector<std::vector<int>> adj(static_cast<size_t>(X.rows()));
-  for (Eigen::Index f = 0; f < F.rows(); ++f)
-    for (int k = 0; k < 3; ++k) {
-      const int a = F(f, k), b = F(f, (k + 1) % 3);
-      adj[static_cast<size_t>(a)].push_back(b);
-      adj[static_cast<size_t>(b)].push_back(a);
-    }
+  const std::vector<std::vector<int>> adj = vertex_neighbours(F, static_cast<int>(X.rows()));
   const size_t n = targets.size();
   std::vector<size_t> parent(n);
   std::iota(parent.begin(), parent.end(), size_t{0});
@@ -99,8 +70,14 @@ FapPartition partition_shared_targets(const Eigen::MatrixXd &X, const Eigen::Mat
         vertices.push_back(targets[k].vertex);
     Eigen::MatrixXd phi(X.rows(), static_cast<Eigen::Index>(vertices.size()));
     for (size_t u = 0; u < vertices.size(); ++u) {
-      const Eigen::VectorXd d = F.rows() > 0 ? path_distances(X, adj, vertices[u])
-                                             : (X.rowwise() - X.row(vertices[u])).rowwise().norm().eval();
+      // Along the edges: across the mouth the lips are far apart even where they touch.
+      Eigen::VectorXd d;
+      if (F.rows() > 0) {
+        const std::vector<double> e = edge_path_distances(X, adj, {vertices[u]});
+        d = Eigen::Map<const Eigen::VectorXd>(e.data(), static_cast<Eigen::Index>(e.size()));
+      } else {
+        d = (X.rowwise() - X.row(vertices[u])).rowwise().norm();
+      }
       phi.col(static_cast<Eigen::Index>(u)) = (d.array().square() + h2).inverse().matrix();
     }
     // A vertex that no FDP's path reaches (not in the mesh, or on another

@@ -19,6 +19,7 @@
 #include "core/part_kind.h"
 #include "fap/fap_mapping.h"
 #include "fap/fap_partition.h"
+#include "fap/jaw_lips.h"
 #include "fap/steer.h"
 #include "fap/untangle.h"
 
@@ -1295,6 +1296,21 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       if (!with.empty())
         o.message += std::string(o.message.empty() ? "" : "; ") + "its FDP is FAP " + with +
                      "'s too: each moves it by a share, measured together at the same value";
+    }
+  }
+  // The jaw's opening leaves the lower lip's height to the lip's FAPs
+  // (jaw_lips.h).
+  {
+    const JawLipHold hold = jaw_lip_hold(model);
+    for (size_t k = 0; k < work.size(); ++k) {
+      const FapMapping *f = work[k].fap;
+      if (!f || f->driver != FapDriver::JawOpen || !results[k].target || hold.lip.empty()) continue;
+      MorphTarget &t = *results[k].target;
+      Eigen::MatrixXd &D = t.displacement[static_cast<size_t>(model.skin)];
+      if (D.rows() != skin.n) continue;
+      keep_lip_height(hold, D);
+      for (const SkinBinding &b : carried) t.displacement[static_cast<size_t>(b.part)] = Eigen::MatrixXd();
+      carry(D, t);
     }
   }
   // The slivers a target turns over are untangled (untangle.h). A FAP's

@@ -117,8 +117,10 @@ expect_error "bad simulation size" 2 "at least 200, or full" - -- "$bin" "$tmp/h
 
 # Lips that are one surface, as a scan's: the generated head with its closed
 # mouth slit welded shut, its FDPs as coordinates. The import cuts the lip
-# line, and the opened jaw parts the lips: the lower lip's middle (2.3) goes
-# down with the chin (2.1), the upper one's (2.2) stays.
+# line, and the lower lip's FAP parts the lips: raise_b_midlip's negative
+# side lowers the lower lip's middle (2.3), the upper one's (2.2) stays. The
+# opened jaw does not open the mouth (fap/jaw_lips.h): the chin (2.1) drops,
+# neither lip's middle does.
 "$gen" --vertices 1000 -o "$tmp/hs.obj" >/dev/null 2>&1 || fail "afm-headgen -o hs.obj failed"
 awk 'NR == FNR { if ($1 == "o") part = $2; if ($1 == "v") { ++n; if (part == "skin") { k = $2 " " $3 " " $4; if (k in first) to[n] = first[k]; else first[k] = n } }; next }
      $1 == "f" { for (i = 2; i <= NF; ++i) { split($i, c, "/"); if (c[1] in to) sub(/^[0-9]+/, to[c[1]], $i) } }
@@ -126,19 +128,25 @@ awk 'NR == FNR { if ($1 == "o") part = $2; if ($1 == "v") { ++n; if (part == "sk
 awk 'NR == FNR { if ($1 == "o") { part = $2; n = 0 } else if ($1 == "v") { xyz[part, n++] = $2 " " $3 " " $4 }; next }
      /^[0-9]+\.[0-9]+[[:space:]]/ && NF == 3 { print $1, xyz[$2, $3]; next } { print }' \
   "$tmp/hs.obj" "$tmp/hs.fdp" | sed 's/+//g' >"$tmp/fused.fdp"
-"$bin" "$tmp/fused.obj" "$tmp/fused.fdp" -q --faps 3 -o "$tmp/fused.afm" >"$tmp/fused.txt" 2>&1 ||
+"$bin" "$tmp/fused.obj" "$tmp/fused.fdp" -q --faps 3,5 -o "$tmp/fused.afm" >"$tmp/fused.txt" 2>&1 ||
   fail "the fused lips' build failed: $(tail -n 5 "$tmp/fused.txt")"
 grep -q "the lips are one surface (FDPs 2.2 and 2.3 on vertex [0-9]*): cut along the lip line" "$tmp/fused.txt" ||
   fail "the fused lips are not cut: $(head -n 4 "$tmp/fused.txt")"
 "$export_obj" "$tmp/fused.afm" --obj "$tmp/fused_obj" --quiet || fail "afm-export --obj of the fused head failed"
 "$info" --fdps "$tmp/fused.afm" | awk '$1 == "2.1" || $1 == "2.2" || $1 == "2.3" { print $1, $3 }' >"$tmp/fused_v.txt"
-drops=$(awk 'NR == FNR { at[$1] = $2 + 1; next }
-  FILENAME ~ /neutral/ && $1 == "v" { y0[++a] = $3 }
-  FILENAME ~ /open_jaw/ && $1 == "v" { y1[++b] = $3 }
-  END { printf "%.6f %.6f %.6f", y0[at["2.1"]] - y1[at["2.1"]], y0[at["2.2"]] - y1[at["2.2"]], y0[at["2.3"]] - y1[at["2.3"]] }' \
-  "$tmp/fused_v.txt" "$tmp/fused_obj/neutral.obj" "$tmp/fused_obj/open_jaw.obj")
-echo "$drops" | awk '{ exit !($1 > 0.003 && $3 > 0.5 * $1 && $2 < 0.1 * $1) }' ||
-  fail "open_jaw does not part the cut lips (drop of 2.1, 2.2, 2.3 in model units: $drops)"
+drops() {  # the drop of 2.1, 2.2 and 2.3 in target $1's OBJ, model units
+  awk 'NR == FNR { at[$1] = $2 + 1; next }
+    FILENAME ~ /neutral/ && $1 == "v" { y0[++a] = $3 }
+    FILENAME !~ /neutral/ && $1 == "v" { y1[++b] = $3 }
+    END { printf "%.6f %.6f %.6f", y0[at["2.1"]] - y1[at["2.1"]], y0[at["2.2"]] - y1[at["2.2"]], y0[at["2.3"]] - y1[at["2.3"]] }' \
+    "$tmp/fused_v.txt" "$tmp/fused_obj/neutral.obj" "$tmp/fused_obj/$1.obj"
+}
+d=$(drops raise_b_midlip_neg)
+echo "$d" | awk '{ exit !($3 > 0.002 && $2 < 0.1 * $3) }' ||
+  fail "raise_b_midlip's negative side does not part the cut lips (drop of 2.1, 2.2, 2.3 in model units: $d)"
+d=$(drops open_jaw)
+echo "$d" | awk '{ exit !($1 > 0.003 && $2 < 0.1 * $1 && $3 < 0.1 * $1 && $3 > -0.1 * $1) }' ||
+  fail "open_jaw opens the mouth (drop of 2.1, 2.2, 2.3 in model units: $d)"
 
 # Placement only: the summary and three pictures.
 "$bin" "$tmp/h.wrl" "$tmp/h.fdp" --no-calibrate -q --muscle-map "$tmp/map.png" \

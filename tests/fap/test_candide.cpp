@@ -243,6 +243,45 @@ TEST(Candide3, TargetsMoveTheWayCandidesFapBlocksDo) {
   std::printf("%s", table.c_str());
   EXPECT_GE(compared, 60) << "too few targets compared:\n" << table;
   EXPECT_LE(skipped, 2) << table;
+
+  // The jaw opens without opening the mouth (MPEG-4: "does not affect mouth
+  // opening"): Candide's FAP 3 block moves the chin only, and the lower
+  // lip's FDPs (those of FAPs 5, 10, 11, 52, 57, 58) move by their own
+  // FAPs. Ours, at every FAP 3 target, must leave those FDPs' height.
+  const CandideBlock *jaw = nullptr;
+  for (const CandideBlock &k : c.faps)
+    if (k.fap == 3) jaw = &k;
+  ASSERT_NE(jaw, nullptr) << "Candide-3 has no FAP 3 block";
+  const FdpPoint *chin = m.fdps.find(FdpId{2, 1}, m.skin);
+  ASSERT_TRUE(chin && chin->vertex >= 0);
+  int jaw_targets = 0, lip_fdps = 0;
+  for (size_t t = 0, o = 0; o < syn->outcomes.size(); ++o) {
+    const FapOutcome &out = syn->outcomes[o];
+    if (!out.made) continue;
+    const MorphTarget &target = syn->targets[t++];
+    if (out.kind != AFM_TARGET_FAP || out.number != 3) continue;
+    ++jaw_targets;
+    const Eigen::MatrixXd &D = target.displacement[static_cast<size_t>(m.skin)];
+    const double drop = -D(chin->vertex, 1);
+    ASSERT_GT(drop, 0) << "FAP 3 at " << out.reference << " does not lower the chin";
+    lip_fdps = 0;
+    for (int fap : {5, 10, 11, 52, 57, 58}) {
+      const auto f = fdp_vertex.find(fap);
+      if (f == fdp_vertex.end()) continue;
+      const bool candide_moves = std::any_of(jaw->moves.begin(), jaw->moves.end(),
+                                             [&](const auto &mv) { return mv.first == f->second; });
+      EXPECT_FALSE(candide_moves) << "Candide's jaw moves FAP " << fap << "'s FDP";
+      const auto v = vertex_of_candide.find(f->second);
+      if (candide_moves || v == vertex_of_candide.end()) continue;
+      ++lip_fdps;
+      const double dy = D(v->second, 1);
+      std::printf("FAP 3 at %d: the chin drops %.4g, FAP %d's FDP moves %.3g in height\n", out.reference, drop, fap,
+                  dy);
+      EXPECT_LT(std::abs(dy), 0.05 * drop) << "FAP 3 at " << out.reference << " moves FAP " << fap << "'s FDP";
+    }
+    EXPECT_EQ(lip_fdps, 6) << "the lower lip's FDPs were not all matched to Candide's";
+  }
+  EXPECT_EQ(jaw_targets, 3) << "FAP 3's reference and its two in-betweens";
 }
 
 }  // namespace

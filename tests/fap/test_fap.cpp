@@ -31,6 +31,7 @@
 #include "fap/fap_mapping.h"
 #include "fap/fap_partition.h"
 #include "fap/fap_synthesis.h"
+#include "fap/jaw_lips.h"
 #include "fap/fidelity_report.h"
 #include "fap/steer.h"
 #include "fap/untangle.h"
@@ -297,6 +298,8 @@ TEST(FapSynthesis, TheJawsRigidControlsMoveTheChinAsEachTargetDoes) {
   const FaceModel &m = head_1k().model;
   const FapSynthesis &s = synthesis();
   ASSERT_FALSE(s.jaw.parts.empty()) << "the reference head has lower teeth and a tongue";
+  const JawLipHold hold = jaw_lip_hold(m);
+  ASSERT_FALSE(hold.lip.empty()) << "the reference head has a lower lip";
   // FAP 3 turns the jaw about x and glides it forward (jaw.h), whole
   // values first; its in-betweens bend both at knots.
   ASSERT_GE(s.jaw.controls.size(), 2u);
@@ -327,18 +330,30 @@ TEST(FapSynthesis, TheJawsRigidControlsMoveTheChinAsEachTargetDoes) {
     EXPECT_LT(std::abs(chin.z()), 0.25 * -chin.y()) << chin.transpose();
     // The skin over the jaw follows the bone through the tissue: on average
     // within 15 % of the rigid motion, or the lower teeth would part from
-    // the lip.
+    // the lip. The bone's motion less the height the lower lip keeps
+    // (jaw_lips.h: the mouth stays closed).
     const Eigen::MatrixXd &D = t->displacement[static_cast<size_t>(m.skin)];
     ASSERT_FALSE(m.jaw.vertices.empty());
+    ASSERT_EQ(hold.share.size(), m.tissue.n);
     double off = 0, rigid = 0;
     for (int v : m.jaw.vertices) {
       const Eigen::Vector3d p = m.tissue.X0.row(v).transpose();
       const Eigen::Vector3d q = s.jaw.pivot + Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitX()) * (p - s.jaw.pivot) +
                                 glide * Eigen::Vector3d::UnitZ();
-      off += (D.row(v).transpose() - (q - p)).norm();
-      rigid += (q - p).norm();
+      Eigen::Vector3d bone = q - p;
+      bone.y() *= hold.share(v);
+      off += (D.row(v).transpose() - bone).norm();
+      rigid += bone.norm();
     }
     EXPECT_LT(off, 0.15 * rigid);
+    // The mouth stays closed: the lower lip's FDPs keep their height, and
+    // the lip is held at all of them.
+    for (const char *id : {"2.3", "2.8", "2.9", "8.2", "8.7", "8.8"}) {
+      const FdpPoint *p = m.fdps.find(*FdpId::parse(id), m.skin);
+      ASSERT_TRUE(p && p->vertex >= 0) << id;
+      EXPECT_TRUE(std::binary_search(hold.lip.begin(), hold.lip.end(), p->vertex)) << id << " is not held";
+      EXPECT_LT(std::abs(D(p->vertex, 1)), 0.02 * -chin.y()) << id << " moves in height";
+    }
     std::printf("FAP 3 at %d: the jaw turns %.4f rad (%.4f per 1024 units), the skin over it %.1f %% off the bone\n",
                 t->reference, angle, angle / t->reference * 1024, 100 * off / rigid);
   }
