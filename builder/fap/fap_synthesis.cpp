@@ -222,6 +222,11 @@ int fdp_vertex(const FaceModel &model, const afm_fap_info *info) {
   return p && p->part == model.skin && p->vertex >= 0 ? p->vertex : -1;
 }
 
+// The lower lip's FAPs: its middle and mid-left/right, inner and outer.
+bool lower_lip_fap(int fap) {
+  return fap == 5 || fap == 10 || fap == 11 || fap == 52 || fap == 57 || fap == 58;
+}
+
 // The lip corners, inner (2.4, 2.5) and outer (8.3, 8.4).
 bool lip_corner_fdp(const afm_fap_info *info) {
   return (info->fdp_group == 2 && (info->fdp_index == 4 || info->fdp_index == 5)) ||
@@ -1244,6 +1249,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     carry(D, t);
   }
   // FAP targets that move the same skin split it (fap_partition.h).
+  std::vector<Eigen::VectorXd> skin_share(work.size());  // per target: its share, empty when whole
   {
     std::vector<SharingTarget> sharing(work.size());
     for (size_t k = 0; k < work.size(); ++k) {
@@ -1263,6 +1269,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       sharing[k].displacement = &results[k].target->displacement[static_cast<size_t>(model.skin)];
     }
     const FapPartition part = partition_shared_targets(skin.X0.topRows(skin.n), skin.F, sharing);
+    skin_share = part.weight;
     const size_t sk = static_cast<size_t>(model.skin);
     for (size_t k = 0; k < work.size(); ++k) {
       if (part.weight[k].size() == 0) continue;
@@ -1300,6 +1307,10 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
   }
   // The jaw's opening leaves the lower lip's height to the lip's FAPs
   // (jaw_lips.h).
+  // The height FAP 3's farthest target gives up, per skin vertex (y), and
+  // its reference: past their reach the lower lip's FAPs go on with it.
+  Eigen::VectorXd lip_given_up;
+  int given_up_at = 0;
   {
     const JawLipHold hold = jaw_lip_hold(model);
     for (size_t k = 0; k < work.size(); ++k) {
@@ -1308,6 +1319,10 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       MorphTarget &t = *results[k].target;
       Eigen::MatrixXd &D = t.displacement[static_cast<size_t>(model.skin)];
       if (D.rows() != skin.n) continue;
+      if (work[k].reference > given_up_at) {
+        given_up_at = work[k].reference;
+        lip_given_up = D.col(1).cwiseProduct((1 - hold.share.array()).matrix());
+      }
       keep_lip_height(hold, D);
       for (const SkinBinding &b : carried) t.displacement[static_cast<size_t>(b.part)] = Eigen::MatrixXd();
       carry(D, t);
@@ -1373,8 +1388,55 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     o.seconds = 0;
     o.message = "holds the reach of " + std::to_string(o.side * reach) + "; " + o.message;
   };
+  // A lower lip FAP's negative side past its target (jaw_lips.h, "Past
+  // the lip's reach"): an in-between at FAP 3's farthest reference, the
+  // side's pose plus the height FAP 3's target gave up there, times the
+  // side's share of the split skin, scaled so the FDP reaches that value.
+  auto lip_past_reach = [&](size_t k, const MorphTarget &t, const FapOutcome &o,
+                            const std::vector<char> &hold) -> std::optional<std::pair<MorphTarget, FapOutcome>> {
+    const FapMapping *f = work[k].fap;
+    if (!f || f->driver != FapDriver::Muscles || work[k].side > 0 || work[k].in_between || !o.made ||
+        !lower_lip_fap(f->fap) || lip_given_up.size() != skin.n || std::abs(o.reference) >= given_up_at)
+      return std::nullopt;
+    const afm_fap_info *info = afm_fap(f->fap);
+    const int v = fdp_vertex(model, info);
+    const Eigen::MatrixXd &D = t.displacement[static_cast<size_t>(model.skin)];
+    if (v < 0 || D.rows() != skin.n) return std::nullopt;
+    const Eigen::Vector3d along = work[k].side * fap_direction(info);
+    const double unit = o.prescribed.dot(along) / std::abs(o.reference);
+    Eigen::VectorXd G = lip_given_up;
+    if (skin_share[k].size() == skin.n) G.array() *= skin_share[k].array();
+    const double own = D.row(v).dot(along.transpose()), more = G(v) * along.y();
+    const double alpha = (given_up_at * unit - own) / more;
+    if (!(more > 0) || !(alpha > 0)) return std::nullopt;
+    std::pair<MorphTarget, FapOutcome> far{t, o};
+    MorphTarget &ft = far.first;
+    FapOutcome &fo = far.second;
+    Eigen::MatrixXd &E = ft.displacement[static_cast<size_t>(model.skin)];
+    E.col(1) += alpha * G;
+    std::vector<char> h = hold;
+    h[static_cast<size_t>(v)] = kUntangleFixed;
+    untangle(rest, skin.F, h, options.sim, E);
+    for (const SkinBinding &b : carried) ft.displacement[static_cast<size_t>(b.part)] = Eigen::MatrixXd();
+    carry(E, ft);
+    ft.reference = work[k].side * given_up_at;
+    fo.reference = ft.reference;
+    fo.in_between = true;
+    fo.holds = fo.at_reach = false;
+    fo.reached = 1;
+    fo.seconds = 0;
+    fo.prescribed = given_up_at * unit * along;
+    measure(fo, E.row(v).transpose(), fap_direction(info));
+    const SkinFaults faults = skin_faults(model, rest + E);
+    fo.turned = static_cast<int>(faults.turned_faces.size());
+    fo.sunk = static_cast<int>(faults.sunk_vertices.size());
+    fo.message = "past the side's target the lip goes on as FAP 3 at " + std::to_string(given_up_at) +
+                 " would carry it, by this FAP's share (jaw_lips.h)";
+    return far;
+  };
   for (size_t k = 0; k < results.size(); ++k) {
     Result &r = results[k];
+    std::optional<std::pair<MorphTarget, FapOutcome>> far;
     if (r.target && r.target->displacement[static_cast<size_t>(model.skin)].rows() == 0) {
       out.targets.push_back(std::move(*r.target));  // the skin does not move (the tongue's, a pupil's)
     } else if (r.target) {
@@ -1399,10 +1461,15 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       r.outcome.turned = static_cast<int>(faults.turned_faces.size());
       r.outcome.sunk = static_cast<int>(faults.sunk_vertices.size());
       if (holds_reach(k)) split_hold(k, t, r.outcome);
+      far = lip_past_reach(k, t, r.outcome, hold);
       out.targets.push_back(std::move(t));
     }
     if (r.outcome.made) jaw_samples.insert(jaw_samples.end(), r.jaw.begin(), r.jaw.end());
     out.outcomes.push_back(std::move(r.outcome));
+    if (far) {
+      out.targets.push_back(std::move(far->first));
+      out.outcomes.push_back(std::move(far->second));
+    }
   }
   // The jaw's controls bend at FAP 3's in-betweens, so the teeth are where
   // each target's bone is (formats/afm.md, RIGD knots).

@@ -29,6 +29,18 @@
 // through them held the lip in a V at 8.2, the chin creased along it, and
 // the lip's red, which bulges below it, smeared downward (Song, rendered).
 //
+// Past the lip's reach (fap_synthesis.cpp): the lower lip's muscles take it
+// about 315 FAP units down on Song (5 negative), and a stream may ask for
+// more with the jaw open (Xface's fear.fap: -870, with the jaw at 713). So
+// each of those six FAPs' negative sides gets an in-between at FAP 3's
+// farthest reference R3 (1024): its side's pose (the hold, where it holds)
+// plus alpha x w x G, G the height FAP 3's target at R3 gave up here
+// ((1 - s) times its y motion), w the FAP's share of the skin the lip's
+// FAPs split (fap_partition.h), alpha such that the FDP moves by R3 FAP
+// units. Sent with the jaw, as the streams send them, the lip goes on as the
+// jaw would have carried it; sent alone, it drops in front of the closed
+// teeth, as Candide-3's and Xface's linear FAP blocks take it.
+//
 // The visemes and expressions are whole poses, the lip's motion included:
 // their jaw carries the lip as before.
 #pragma once

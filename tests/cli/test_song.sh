@@ -67,8 +67,11 @@ cmp -s "$tmp/fdps_xfaceed.txt" "$tmp/fdps_coords.txt" ||
 # between the inner and outer lip FAPs (builder/fap/fap_partition.h) folds it. On
 # Song those are the lower lip's middle lowered (FAP 5 negative: 2.3 3.03
 # units toward 8.2, 3.49 below it) and its outer line raised (57, 58: 8.7
-# 3.03 toward 2.8, 3.35 above). The lids' slivers turned before the
-# untangling moved their corners (19, 20).
+# 3.03 toward 2.8, 3.35 above). The lower lip's in-betweens at -1024
+# (builder/fap/jaw_lips.h) carry its FDPs most of the way to the chin (2.1),
+# which the jaw moves away when the streams send them together (fear.fap
+# turns no more with them: the --folds lines below). The lids' slivers turned
+# before the untangling moved their corners (19, 20).
 awk -F, 'NR > 1 { print "fap", $1, $8 }' "$AFM_SHARED_DIR/reference/mpeg4-fap-table.csv" >"$tmp/turned_in.txt"
 tr -d '()+' <"$tmp/fdps_xfaceed.txt" | awk '{ print "fdp", $1, $2, $3, $4, $5 }' >>"$tmp/turned_in.txt"
 sed 's/"[^"]*"//g' "$tmp/report/report.csv" |
@@ -221,6 +224,30 @@ if [ "${AFM_CONFIG:-release}" != sanitize ]; then
     [ -n "$reached" ] || fail "afm-play --fdp-motion: no line for FDP group $group: $(cat "$tmp/motion.txt")"
     awk -v r="$reached" -v lo="$lo" -v hi="$hi" 'BEGIN { exit !(r >= lo && r <= hi) }' ||
       fail "Song, joy.fap: the FDPs of group $group reach $reached % of the stream's motion (median), outside $lo..$hi %"
+  done
+  # The jaw does not open the mouth (builder/fap/jaw_lips.h): the streams
+  # send the lower lip down with the jaw themselves. While FAP 3's targets
+  # carried the lip, the inner and outer lips' 90th percentile was 179-188 %
+  # of the prescription in joy, anger and disgust; now 100-112 %. fear.fap sends
+  # the lip to -870, past the lip's own reach (315): its outer lip's median
+  # distance from the prescription was 32 % with the jaw carrying the lip, 59 %
+  # with the lip held at its reach, 26 % going on past it as the jaw would
+  # have carried it (its outer lip's 90th percentile, 160 %, is the lip
+  # corners at -400, past their reach).
+  for f in joy anger disgust fear; do
+    "$bin/afm-play" "$tmp/song.afm" "$AFM_SHARED_DIR/data/fap/xface/$f.fap" --quiet --fdp-motion \
+      >"$tmp/motion_$f.txt" 2>&1 || fail "afm-play --fdp-motion failed on Song with $f.fap: $(tail -n 3 "$tmp/motion_$f.txt")"
+    for group in 2 8; do
+      # reached (median), off by (median), reached (90th percentile)
+      set -- $(awk -v g="$group" '$1 == g { for (i = 2; i <= NF; ++i) if ($i ~ /^[0-9]+$/) { print $(i + 1), $(i + 3), $(i + 5); exit } }' \
+        "$tmp/motion_$f.txt")
+      [ $# -eq 3 ] || fail "afm-play --fdp-motion on $f.fap: no line for FDP group $group: $(cat "$tmp/motion_$f.txt")"
+      echo "Song, $f.fap, FDP group $group: median $1 %, median distance $2 %, 90th percentile $3 %"
+      [ "$f" = fear ] || awk -v p="$3" 'BEGIN { exit !(p <= 130) }' ||
+        fail "Song, $f.fap: FDP group $group reaches $3 % of the prescription at the 90th percentile (over 130 %: the jaw opens the mouth again?)"
+      [ "$f" != fear ] || awk -v d="$2" 'BEGIN { exit !(d <= 40) }' ||
+        fail "Song, fear.fap: FDP group $group is a median $2 % of the prescription away (over 40 %: the lower lip stops at its reach?)"
+    done
   done
 fi
 
