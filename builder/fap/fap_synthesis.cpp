@@ -1306,9 +1306,8 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     }
   }
   // The jaw's opening leaves the lower lip's height to the lip's FAPs
-  // (jaw_lips.h).
-  // The height FAP 3's farthest target gives up, per skin vertex (y), and
-  // its reference: past their reach the lower lip's FAPs go on with it.
+  // (jaw_lips.h). What FAP 3's farthest target gives up (#n, y) and its
+  // reference are kept: past their reach the lower lip's FAPs go on with it.
   Eigen::VectorXd lip_given_up;
   int given_up_at = 0;
   {

@@ -40,7 +40,9 @@
 // On a simulation mesh the tarsus is held further off the eyeball by what
 // the lifted skin over it sinks below its clearance, in one more solve.
 //
-// A lip corner's FAP moves the skin around the corner with it ("The
+// FAP 3's targets leave the lower lip's height to the lip's FAPs, whose
+// negative sides go on past their reach as the jaw would carry the lip
+// (jaw_lips.h). A lip corner's FAP moves the skin around the corner with it ("The
 // modiolus" below). FAP targets that move the same skin (the inner and
 // outer lip FAPs, the midlip and mid-left/right ones, the brows, ...) then
 // split it between
@@ -158,7 +160,7 @@ struct FapOutcome {
   int side = +1;                  // +1: the positive reference, -1: the negative one
   int reference = 0;              // signed FAP units (63 for visemes and expressions)
   bool in_between = false;        // one of FapMapping::farther (made only where reached in full),
-                                  // or a hold
+                                  // a hold, or a lower lip side past its reach (jaw_lips.h)
   bool holds = false;             // an in-between at the table's reference holding an
                                   // under-reaching side's pose ("Reach, then hold")
   bool at_reach = false;          // that side's target at the FAP units it reaches
