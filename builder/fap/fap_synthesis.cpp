@@ -297,7 +297,7 @@ CalibrationNeeds calibration_needs(const FapSynthesisOptions &options) {
 }
 
 bool solved_fap_target(const FapOutcome &o) {
-  return o.made && o.kind == AFM_TARGET_FAP && !kinematic_fap(o.number);
+  return o.made && o.kind == AFM_TARGET_FAP && !kinematic_fap(o.number) && !o.from_jaw;
 }
 
 Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &model, const FapSynthesisOptions &options) {
@@ -1422,6 +1422,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     fo.reference = ft.reference;
     fo.in_between = true;
     fo.holds = fo.at_reach = false;
+    fo.from_jaw = true;
     fo.reached = 1;
     fo.seconds = 0;
     fo.prescribed = given_up_at * unit * along;

@@ -164,6 +164,8 @@ struct FapOutcome {
   bool holds = false;             // an in-between at the table's reference holding an
                                   // under-reaching side's pose ("Reach, then hold")
   bool at_reach = false;          // that side's target at the FAP units it reaches
+  bool from_jaw = false;          // a lower lip side's in-between past its reach, made from
+                                  // FAP 3's target (jaw_lips.h), not solved
   bool made = false;              // a target was made
   std::string message;            // why not, when !made; how far it reaches when it under-reaches
   double reached = 1;             // the achieved share of the prescribed motion along the
@@ -195,8 +197,9 @@ struct FapOutcome {
 
 // Whether a made outcome is a FAP target the face model solved (muscles,
 // jaw, lids): the ones the fidelity figures summarise. The tongue's and the
-// pupils' (kinematic_fap) are exact by construction, and visemes and
-// expressions have no FDP rule.
+// pupils' (kinematic_fap) and the lower lip's in-betweens past its reach
+// (from_jaw) are exact by construction, and visemes and expressions have no
+// FDP rule.
 bool solved_fap_target(const FapOutcome &o);
 
 struct FapSynthesisOptions {

@@ -37,7 +37,8 @@ std::string target_label(const FapOutcome &outcome);
 // where it has one (why it was not made, how far it under-reaches, which
 // helpers steered it, what was untangled), then one summary line: targets
 // made and not, and over the FAP targets the model solved (solved_fap_target:
-// the tongue's and the pupils' are listed apart, exact by construction) the
+// the tongue's and the pupils', and the lower lip's in-betweens past its
+// reach, are listed apart, exact by construction) the
 // median and worst error along the direction and off it, and the medians of
 // the off-axis parts across the face and in depth. Each FAP side counts once,
 // at the table's reference: a held side (fap_synthesis.h, "Reach, then
