@@ -20,6 +20,7 @@
 #include "fap/fap_mapping.h"
 #include "fap/fap_partition.h"
 #include "fap/jaw_lips.h"
+#include "fap/teeth_clearance.h"
 #include "fap/steer.h"
 #include "fap/untangle.h"
 
@@ -1308,8 +1309,9 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
   // The jaw's opening leaves the lower lip's height to the lip's FAPs
   // (jaw_lips.h). What FAP 3's farthest target gives up (#n, y) and its
   // reference are kept: past their reach the lower lip's FAPs go on with it.
-  Eigen::VectorXd lip_given_up;
+  Eigen::VectorXd lip_given_up, lip_pushed;
   int given_up_at = 0;
+  std::optional<TeethClearance> teeth;
   {
     const JawLipHold hold = jaw_lip_hold(model);
     for (size_t k = 0; k < work.size(); ++k) {
@@ -1323,6 +1325,22 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         lip_given_up = D.col(1).cwiseProduct((1 - hold.share.array()).matrix());
       }
       keep_lip_height(hold, D);
+      // The teeth turn down behind the held lip (teeth_clearance.h).
+      if (!teeth) teeth = teeth_clearance(scene, model, options.sim);
+      const TeethPush push = keep_before_teeth(*teeth, jaw_motion(model.jaw, 100 * results[k].outcome.scale, 0, 0), D);
+      if (work[k].reference == given_up_at) lip_pushed = push.push;
+      if (push.pushed > 0) {
+        char what[200];
+        std::snprintf(what, sizeof what,
+                      "the skin over the lower teeth pushed forward at %d vertices, by up to %.2g MNS0%s",
+                      push.pushed, push.deepest / model.fapu.mns0,
+                      push.left > 0 ? " (some short of the clearance)" : "");
+        FapOutcome &o = results[k].outcome;
+        o.message += std::string(o.message.empty() ? "" : "; ") + what;
+        // The push may reach the chin's FDP: measured as stored.
+        const afm_fap_info *info = afm_fap(f->fap);
+        if (const int v = fdp_vertex(model, info); v >= 0) measure(o, D.row(v).transpose(), fap_direction(info));
+      }
       for (const SkinBinding &b : carried) t.displacement[static_cast<size_t>(b.part)] = Eigen::MatrixXd();
       carry(D, t);
     }
@@ -1413,6 +1431,14 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     FapOutcome &fo = far.second;
     Eigen::MatrixXd &E = ft.displacement[static_cast<size_t>(model.skin)];
     E.col(1) += alpha * G;
+    // The push over the teeth that FAP 3's target made goes with the hold;
+    // in front of the closed teeth the skin keeps its clearance.
+    if (lip_pushed.size() == skin.n) {
+      Eigen::VectorXd Z = lip_pushed;
+      if (skin_share[k].size() == skin.n) Z.array() *= skin_share[k].array();
+      E.col(2) -= alpha * Z;
+      if (teeth) keep_before_teeth(*teeth, Eigen::Affine3d::Identity(), E);
+    }
     std::vector<char> h = hold;
     h[static_cast<size_t>(v)] = kUntangleFixed;
     untangle(rest, skin.F, h, options.sim, E);

@@ -39,7 +39,12 @@
 // FAPs split (fap_partition.h), alpha such that the FDP moves by R3 FAP
 // units. Sent with the jaw, as the streams send them, the lip goes on as the
 // jaw would have carried it; sent alone, it drops in front of the closed
-// teeth, as Candide-3's and Xface's linear FAP blocks take it.
+// teeth, as Candide-3's and Xface's linear FAP blocks take it. The push that
+// kept FAP 3's target at R3 in front of the lower teeth (teeth_clearance.h)
+// goes back the same way, by alpha x w, and the in-between keeps its own
+// clearance over the closed teeth: left in, the push took the generated
+// 2,000-vertex head's outer lip 5 points further from Xface's fear.fap
+// (median distance from the prescription).
 //
 // The visemes and expressions are whole poses, the lip's motion included:
 // their jaw carries the lip as before.
