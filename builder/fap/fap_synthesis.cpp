@@ -1307,8 +1307,10 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     }
   }
   // The jaw's opening leaves the lower lip's height to the lip's FAPs
-  // (jaw_lips.h). What FAP 3's farthest target gives up (#n, y) and its
-  // reference are kept: past their reach the lower lip's FAPs go on with it.
+  // (jaw_lips.h). What FAP 3's farthest target gives up (#n, y), the push
+  // that keeps its skin in front of the lower teeth (#n, z:
+  // teeth_clearance.h) and its reference are kept: past their reach the
+  // lower lip's FAPs go on with it.
   Eigen::VectorXd lip_given_up, lip_pushed;
   int given_up_at = 0;
   std::optional<TeethClearance> teeth;
@@ -1334,7 +1336,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         std::snprintf(what, sizeof what,
                       "the skin over the lower teeth pushed forward at %d vertices, by up to %.2g MNS0%s",
                       push.pushed, push.deepest / model.fapu.mns0,
-                      push.left > 0 ? " (some short of the clearance)" : "");
+                      push.left > 0 ? " (some still short of the clearance)" : "");
         FapOutcome &o = results[k].outcome;
         o.message += std::string(o.message.empty() ? "" : "; ") + what;
         // The push may reach the chin's FDP: measured as stored.

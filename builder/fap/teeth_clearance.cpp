@@ -195,12 +195,13 @@ TeethPush keep_before_teeth(const TeethClearance &c, const Eigen::Affine3d &jaw,
       if (worst <= tolerance) break;
     }
     for (const Need &n : need) out.left = std::max(out.left, n.goal - lifted(n));
+    if (out.left <= tolerance) out.left = 0;
   }
   // Spread: each moved vertex takes its neighbours along, by
   // push(u) w(d / (kTeethSpread push(u))), w(t) = (1 - t^2)^2, d along the
   // mesh's edges; the largest of these per vertex. Alone, the pushed
-  // vertices stood out of their neighbours and turned triangles over (the
-  // 2,000-vertex head at 1024: ten of them).
+  // vertices stood out, and untangling their folds let teeth out again
+  // (teeth_clearance.h).
   const SkinModel &skin = *c.skin;
   const Eigen::VectorXd own = out.push;
   for (Eigen::Index u = 0; u < own.size(); ++u) {

@@ -38,7 +38,9 @@
 // skin around it along, by push(u) w(d / (kTeethSpread push(u))), w(t) =
 // (1 - t^2)^2 (t < 1), d along the model mesh's edges, the largest such per
 // vertex (only more push, so every constraint stays met): alone, the pushed
-// vertices stood out of their neighbours and turned triangles over.
+// vertices stood out of their neighbours, and once untangling (untangle.h)
+// had flattened the triangles they turned, two tooth vertices of the
+// 2,000-vertex head's target at 1024 were 0.045 MNS0 out again.
 #pragma once
 
 #include <Eigen/Core>
@@ -106,7 +108,7 @@ TeethClearance teeth_clearance(const Scene &scene, const FaceModel &model, const
 struct TeethPush {
   int pushed = 0;          // fine vertices that had to move
   double deepest = 0;      // the largest shortfall before, model units
-  double left = 0;         // the largest shortfall after (0 without a lift)
+  double left = 0;         // the largest shortfall left (0 without a lift, or within a thousandth of the cap)
   Eigen::VectorXd push;    // #n: the z added to each coarse (model) vertex
 };
 
