@@ -389,8 +389,8 @@ afmtest::OutsideSurface lower_teeth_outside(const Scene &scene, const Part &skin
 // The lower teeth, turned with the jaw, stay behind the skin the lip holds
 // (fap/teeth_clearance.h): seen along -z from each tooth vertex, the skin is
 // met from within. Found on the generated heads: at 640 and 1024 the crowns
-// came out through the skin under the held lip, here by up to 0.38 MNS0 (on
-// the 2,000-vertex head on 1,000 simulation vertices, by up to 0.5).
+// came out through the skin under the held lip, on the 1,000-vertex head by
+// up to 0.38 MNS0 (103 of its 332 tooth vertices at 1024).
 void expect_teeth_behind_the_skin(const Scene &scene, const Part &skin, const FapSynthesis &s, int skin_part,
                                   double mns0) {
   const afmtest::OutsideSurface rest =
