@@ -11,6 +11,7 @@
 #include <array>
 
 #include "core/atomic_file.h"
+#include "core/normals.h"
 
 namespace afmb {
 
@@ -21,20 +22,10 @@ int16_t q14(double v) { return clamp16(std::lround(v * 16384.0)); }
 uint8_t byte01(double v) { return static_cast<uint8_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0)); }
 
 // #V x 3 area-weighted vertex normals of one part (zero rows become +z).
-Eigen::MatrixXd vertex_normals(const Eigen::MatrixXd &V, const Eigen::MatrixXi &F) {
-  Eigen::MatrixXd N = Eigen::MatrixXd::Zero(V.rows(), 3);
-  for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
-    Eigen::Vector3d n = (b - a).cross(c - a);  // length = 2 x area: area weighting
-    for (int k = 0; k < 3; ++k) N.row(F(f, k)) += n.transpose();
-  }
-  for (Eigen::Index i = 0; i < N.rows(); ++i) {
-    double len = N.row(i).norm();
-    if (len > 0)
-      N.row(i) /= len;
-    else
-      N.row(i) = Eigen::RowVector3d(0, 0, 1);
-  }
+Eigen::MatrixXd part_normals(const Eigen::MatrixXd &V, const Eigen::MatrixXi &F) {
+  Eigen::MatrixXd N = vertex_normals(V, F);
+  for (Eigen::Index i = 0; i < N.rows(); ++i)
+    if (N.row(i).isZero(0)) N.row(i) = Eigen::RowVector3d(0, 0, 1);
   return N;
 }
 
@@ -239,7 +230,7 @@ Expected<std::vector<uint8_t>> encode_afm(const AfmContent &content, afm_profile
   size_t tri_first = 0;
   for (size_t p = 0; p < scene.parts.size(); ++p) {
     const Part &part = scene.parts[p];
-    normals[p] = vertex_normals(part.V, part.F);
+    normals[p] = part_normals(part.V, part.F);
     const bool split = part.TC.rows() > 0 && part.FTC.rows() == part.F.rows();
     // Texcoord of each copy: copies were made in order of first corner use.
     std::vector<std::map<int, uint32_t>> copy_of_tc(static_cast<size_t>(part.V.rows()));
@@ -362,7 +353,7 @@ Expected<std::vector<uint8_t>> encode_afm(const AfmContent &content, afm_profile
     std::vector<Eigen::MatrixXd> moved_normals(scene.parts.size());
     for (size_t p = 0; p < scene.parts.size() && mt.normals; ++p)
       if (p < mt.displacement.size() && mt.displacement[p].rows() == scene.parts[p].V.rows())
-        moved_normals[p] = vertex_normals(scene.parts[p].V + mt.displacement[p], scene.parts[p].F);
+        moved_normals[p] = part_normals(scene.parts[p].V + mt.displacement[p], scene.parts[p].F);
     // Quantised deltas by entry (render vertex, then control), then runs in
     // ascending order.
     std::vector<std::pair<uint32_t, std::array<int16_t, 6>>> moved;

@@ -7,6 +7,8 @@
 #include <optional>
 #include <unordered_map>
 
+#include "core/normals.h"
+
 namespace afmb {
 
 namespace {
@@ -72,22 +74,6 @@ std::optional<EyeSphere> fit_sphere(const Eigen::MatrixXd &P) {
   }
   if (std::sqrt(err / static_cast<double>(P.rows())) > 0.1 * s.radius) return std::nullopt;
   return s;
-}
-
-// Area-weighted unit vertex normals (#V x 3; zero rows for vertices no
-// triangle uses).
-Eigen::MatrixXd vertex_normals(const Eigen::MatrixXd &V, const Eigen::MatrixXi &F) {
-  Eigen::MatrixXd N = Eigen::MatrixXd::Zero(V.rows(), 3);
-  for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), d = V.row(F(f, 2));
-    const Eigen::Vector3d nrm = (b - a).cross(d - a);  // twice the area
-    for (int k = 0; k < 3; ++k) N.row(F(f, k)) += nrm.transpose();
-  }
-  for (Eigen::Index v = 0; v < V.rows(); ++v) {
-    const double len = N.row(v).norm();
-    if (len > 0) N.row(v) /= len;
-  }
-  return N;
 }
 
 // Per vertex of V (#V x 3, unit normals N): the eyeball in `eyes` it lies

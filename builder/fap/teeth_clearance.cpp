@@ -6,6 +6,7 @@
 
 #include "anatomy/jaw.h"
 #include "core/edge_paths.h"
+#include "core/normals.h"
 #include "core/part_kind.h"
 
 namespace afmb {
@@ -35,8 +36,8 @@ void dilate_line(double *z, int n, int stride, double cell, double rho, int reac
 double DepthMap::at(double x, double y) const {
   const double u = (x - x0) / cell, w = (y - y0) / cell;
   if (!(u >= 0) || !(w >= 0) || u > nx - 1 || w > ny - 1) return kNone;
-  const int i = std::min(static_cast<int>(u), nx - 2 < 0 ? 0 : nx - 2),
-            j = std::min(static_cast<int>(w), ny - 2 < 0 ? 0 : ny - 2);
+  const int i = std::min(static_cast<int>(u), std::max(nx - 2, 0)),
+            j = std::min(static_cast<int>(w), std::max(ny - 2, 0));
   const int i1 = std::min(i + 1, nx - 1), j1 = std::min(j + 1, ny - 1);
   const double fu = u - i, fw = w - j;
   const double a = z[static_cast<size_t>(j * nx + i)], b = z[static_cast<size_t>(j * nx + i1)],
@@ -114,7 +115,7 @@ TeethClearance teeth_clearance(const Scene &scene, const FaceModel &model, const
   c.skin = &skin;
   c.skin_V = lifted ? sim->skin_V : Eigen::MatrixXd(skin.X0.topRows(skin.n));
   const Eigen::MatrixXi &F = lifted ? sim->skin_F : skin.F;
-  // The jaw's share per fine vertex, and area-weighted vertex normals.
+  // The jaw's share per fine vertex.
   const std::vector<double> coarse = jaw_shares(model.jaw, skin.n);
   Eigen::VectorXd share(c.skin_V.rows());
   for (Eigen::Index v = 0; v < share.size(); ++v) {
@@ -125,15 +126,10 @@ TeethClearance teeth_clearance(const Scene &scene, const FaceModel &model, const
     share(v) = 0;
     for (int i = 0; i < 3; ++i) share(v) += sim->binding.weight(v, i) * coarse[static_cast<size_t>(sim->binding.corner(v, i))];
   }
-  Eigen::MatrixXd N = Eigen::MatrixXd::Zero(c.skin_V.rows(), 3);
-  for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    const Eigen::Vector3d a = c.skin_V.row(F(f, 0)), b = c.skin_V.row(F(f, 1)), d = c.skin_V.row(F(f, 2));
-    const Eigen::RowVector3d n = (b - a).cross(d - a).transpose();
-    for (int k = 0; k < 3; ++k) N.row(F(f, k)) += n;
-  }
+  const Eigen::MatrixXd N = vertex_normals(c.skin_V, F);
   std::vector<double> clearance;
   for (Eigen::Index v = 0; v < c.skin_V.rows(); ++v) {
-    if (!(N(v, 2) > kFacing * N.row(v).norm()) || share(v) < 0.5) continue;
+    if (!(N(v, 2) > kFacing) || share(v) < 0.5) continue;
     const double e = c.rest.at(c.skin_V(v, 0), c.skin_V(v, 1));
     // Behind the teeth (inside the mouth) or off their reach: free.
     const double gap = c.skin_V(v, 2) - e;

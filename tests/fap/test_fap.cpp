@@ -295,6 +295,15 @@ double control_motion(const RigidPart &r, int fap, afm_dof dof, double value) {
   return m;
 }
 
+// The jaw's rigid motion at FAP 3's value `reference`, from its controls: a
+// turn about x through the pivot, then the glide forward.
+Eigen::Affine3d jaw_at(const RigidPart &jaw, int reference) {
+  const double angle = control_motion(jaw, 3, AFM_DOF_ROTATE_X, reference) * 1e-5,
+               glide = control_motion(jaw, 3, AFM_DOF_TRANSLATE_Z, reference);
+  return Eigen::Translation3d(jaw.pivot + glide * Eigen::Vector3d::UnitZ()) *
+         Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitX()) * Eigen::Translation3d(-jaw.pivot);
+}
+
 TEST(FapSynthesis, TheJawsRigidControlsMoveTheChinAsEachTargetDoes) {
   const FaceModel &m = head_1k().model;
   const FapSynthesis &s = synthesis();
@@ -337,12 +346,11 @@ TEST(FapSynthesis, TheJawsRigidControlsMoveTheChinAsEachTargetDoes) {
     const Eigen::MatrixXd &D = t->displacement[static_cast<size_t>(m.skin)];
     ASSERT_FALSE(m.jaw.vertices.empty());
     ASSERT_EQ(hold.share.size(), m.tissue.n);
+    const Eigen::Affine3d motion = jaw_at(s.jaw, t->reference);
     double off = 0, rigid = 0;
     for (int v : m.jaw.vertices) {
       const Eigen::Vector3d p = m.tissue.X0.row(v).transpose();
-      const Eigen::Vector3d q = s.jaw.pivot + Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitX()) * (p - s.jaw.pivot) +
-                                glide * Eigen::Vector3d::UnitZ();
-      Eigen::Vector3d bone = q - p;
+      Eigen::Vector3d bone = motion * p - p;
       bone.y() *= hold.share(v);
       Eigen::Vector3d miss = D.row(v).transpose() - bone;
       miss.z() = std::min(miss.z(), 0.0);
@@ -376,14 +384,7 @@ afmtest::OutsideSurface lower_teeth_outside(const Scene &scene, const Part &skin
   EXPECT_EQ(teeth.size(), 1u);
   if (teeth.empty()) return {};
   const Eigen::MatrixXd &T = scene.parts[static_cast<size_t>(teeth[0])].V;
-  const double angle = control_motion(jaw, 3, AFM_DOF_ROTATE_X, reference) * 1e-5,
-               glide = control_motion(jaw, 3, AFM_DOF_TRANSLATE_Z, reference);
-  Eigen::MatrixXd moved(T.rows(), 3);
-  for (Eigen::Index i = 0; i < T.rows(); ++i)
-    moved.row(i) = (jaw.pivot + Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitX()) * (T.row(i).transpose() - jaw.pivot) +
-                    glide * Eigen::Vector3d::UnitZ())
-                       .transpose();
-  return afmtest::outside_surface(skin.V + D, skin.F, moved);
+  return afmtest::outside_surface(skin.V + D, skin.F, moved_points(jaw_at(jaw, reference), T));
 }
 
 // The lower teeth, turned with the jaw, stay behind the skin the lip holds
