@@ -87,6 +87,15 @@ const std::vector<MuscleDef> kTable = {
     // paper's nasalis (9.7 -> 9.1) moves the wing back and up.
     {"dilator_naris_left", K::Linear, "1/2 (9.1 + 9.2)", "9.1", nullptr, 0.30, -1, 0.20, 0.10, false, false, false, L::Key, nullptr, nullptr, true},
     {"dilator_naris_right", K::Linear, "1/2 (9.1 + 9.2)", "9.2", nullptr, 0.30, -1, 0.20, 0.10, false, false, false, L::Key, nullptr, nullptr, true},
+    // The chin raised (not in the paper; docs/anatomy.md "Chin raiser"):
+    // mentalis' own pull on the chin's skin (FACS AU 17), which the table's
+    // mentalis, driven as a push on the lower lip, leaves out. A fibre along
+    // the bone from the chin boss (2.10) up toward the lower lip's middle
+    // (8.2), on the skull under it; +100 % takes the boss a fifth of the way
+    // up. Both ends are FDPs, which a simulation mesh keeps anyway: a key
+    // point of its own, halfway, changed the 10k head's mesh and with it
+    // its lower lip's targets.
+    {"chin_raiser", K::Linear, "8.2", "2.10", nullptr, 0.225, +1, 0.20, 0.05, false, false, false, L::Surface},
 };
 
 struct Parser {

@@ -1,8 +1,9 @@
 // The 25 muscles of the method paper (Tables 1 and 2), as data, and the
 // drivers this project adds: four for the lids (the palpebral part of
 // orbicularis oculi, one per lid: docs/anatomy.md "The lids"), two that
-// push the lips out (docs/anatomy.md "Lip protrusion") and two that flare
-// the nose's wings (docs/anatomy.md "Nostril dilators").
+// push the lips out (docs/anatomy.md "Lip protrusion"), two that flare
+// the nose's wings (docs/anatomy.md "Nostril dilators") and one that raises
+// the chin (docs/anatomy.md "Chin raiser").
 //
 // Key points are written as in the paper, affine combinations of FDP
 // positions: "11.1 + 1/6 (11.3 - 11.1)". parse_keypoint() turns one into
@@ -96,7 +97,7 @@ struct MuscleDef {
 // right, then Table 2), then the four lid drivers (upper left, upper right,
 // lower left, lower right), then the two lip protrusion drivers (upper,
 // lower) and the two nostril dilators (left, right): linear muscles that
-// push.
+// push; last the chin raiser, a linear muscle that pulls.
 const std::vector<MuscleDef> &muscle_table();
 // "linear", "sphincter", "lid".
 const char *muscle_kind_name(MuscleKind kind);

@@ -63,8 +63,15 @@ std::vector<FapMapping> make_table() {
   add(15, D::JawShift, 40, {}, {}, "the jaw's sideways translation");
   add(16, D::Muscles, 40, {{"lip_protrusion_lower", 100}}, {{"lip_protrusion_lower", -100}}, "the lower lip pushed out");
   add(17, D::Muscles, 30, {{"lip_protrusion_upper", 100}}, {{"lip_protrusion_upper", -100}}, "the upper lip pushed out");
-  add(18, D::Muscles, 300, {{"mentalis_left", 100}, {"mentalis_right", 100}},
-      {{"mentalis_left", -100}, {"mentalis_right", -100}}, "mentalis lifts the chin's skin");
+  // The chin boss (2.10) raised by the chin raiser (mentalis' pull on the
+  // chin's skin). Mentalis' push on the lower lip, which had it, took the
+  // boss up a third of the reference or less (Song: 84 of 300). Lowered:
+  // no muscle pulls the chin's skin down without the jaw, and no stream in
+  // ../shared/data sends a negative value; the raiser's push with mentalis'
+  // on the lip reaches furthest (docs/anatomy.md "Chin raiser").
+  add(18, D::Muscles, 300, {{"chin_raiser", 100}},
+      {{"chin_raiser", -100}, {"mentalis_left", -100}, {"mentalis_right", -100}},
+      "the chin raiser (mentalis' pull) lifts the chin's skin");
   // ---- group 3: eyelids, eyeballs, pupils ----
   const char *upper = "the upper lid's driver turns it down over the eyeball; where its load falls short, the "
                       "lid turned as a whole by its tarsus (without an eye part: the upper lid's half of "

@@ -177,14 +177,23 @@ int penetrating_nodes(const SkinModel &s, const Eigen::MatrixXd &X, double slack
 
 TEST(MuscleTable, TwentyFiveMusclesWithParsableKeyPoints) {
   const auto &t = muscle_table();
-  ASSERT_EQ(t.size(), 33u) << "the paper's 25, four lid drivers, two lip protrusion drivers, two nostril dilators";
+  ASSERT_EQ(t.size(), 34u)
+      << "the paper's 25, four lid drivers, two lip protrusion drivers, two nostril dilators, the chin raiser";
   int linear = 0, sphincter = 0;
   for (const MuscleDef &d : t) {
     const long row = &d - t.data();
     const bool paper = row < kPaperMuscles, lid = row >= kPaperMuscles && row < kPaperMuscles + 4;
     EXPECT_EQ(d.kind == MuscleKind::Lid, lid) << d.name;
     EXPECT_EQ(d.corner_outer != nullptr, lid) << d.name;
-    if (!paper && !lid) {
+    if (std::string(d.name) == "chin_raiser") {
+      // Mentalis' pull on the chin's skin: a linear muscle along the bone,
+      // the last row.
+      EXPECT_EQ(row + 1, static_cast<long>(t.size()));
+      EXPECT_EQ(d.kind, MuscleKind::Linear);
+      EXPECT_EQ(d.sense, +1);
+      EXPECT_EQ(d.line, PullLine::Surface);
+      EXPECT_STREQ(d.insertion_or_minor, "2.10");
+    } else if (!paper && !lid) {
       // The lip protrusion drivers and the nostril dilators: linear muscles
       // that push (like mentalis) from a key point, on the tissue's whole
       // thickness.
@@ -604,6 +613,22 @@ TEST(Physics, EachMuscleMovesItsRegionTheWayAnatomySays) {
     // 0.33 forward (0.443 mm up).
     std::printf("mentalis: the lower lip's middle up %.3f mm, forward %.3f mm\n", mm(d.y()), mm(d.z()));
     EXPECT_LT(std::abs(d.z()), 0.25 * d.y()) << "mentalis pushes the lip up, not out";
+  }
+  {
+    // The chin raiser takes the chin boss (2.10) up along the chin, more up
+    // than in or out, and barely moves the upper lip (docs/anatomy.md,
+    // "Chin raiser").
+    const Eigen::MatrixXd X = contract(m, "chin_raiser", t);
+    const Eigen::Vector3d d = moved(m, X, "2.10"), upper = moved(m, X, "8.1");
+    std::printf("chin_raiser: 2.10 up %.3f mm, forward %.3f mm, sideways %.3f mm; 8.1 moves %.3f mm\n", mm(d.y()),
+                mm(d.z()), mm(d.x()), mm(upper.norm()));
+    EXPECT_GT(d.y(), 0.2e-3) << "the chin raiser raises the chin";
+    EXPECT_LT(std::abs(d.z()), 0.5 * d.y()) << "up the chin, not into or out of it";
+    EXPECT_LT(std::abs(d.x()), 0.1 * d.y()) << "on the midline";
+    EXPECT_LT(upper.norm(), 0.2 * d.y()) << "the upper lip stays";
+    EXPECT_EQ(inverted_elements(m.tissue, X), 0);
+    EXPECT_EQ(penetrating_nodes(m.tissue, X, 1e-9), 0);
+    EXPECT_TRUE(X.allFinite());
   }
   {
     const Eigen::MatrixXd X = contract(m, "depressor_anguli_left", t);
