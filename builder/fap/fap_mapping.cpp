@@ -65,7 +65,7 @@ std::vector<FapMapping> make_table() {
   add(17, D::Muscles, 30, {{"lip_protrusion_upper", 100}}, {{"lip_protrusion_upper", -100}}, "the upper lip pushed out");
   // The chin boss (2.10) raised by the chin raiser (mentalis' pull on the
   // chin's skin). Mentalis' push on the lower lip, which had it, took the
-  // boss up a third of the reference or less (Song: 84 of 300). Lowered:
+  // boss up 28-51 % of the reference (Song: 84 of 300). Lowered:
   // no muscle pulls the chin's skin down without the jaw, and no stream in
   // ../shared/data sends a negative value; the raiser's push with mentalis'
   // on the lip reaches furthest (docs/anatomy.md "Chin raiser").
