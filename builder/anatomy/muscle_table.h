@@ -78,7 +78,7 @@ struct MuscleDef {
   bool essential;
   // Linear: its line of action (PullLine): Surface for the muscles along the
   // bone (frontalis, corrugator, zygomaticus major, risorius, depressor
-  // anguli), Key for mentalis' push, Skull for the others (nasalis, upper
+  // anguli, the chin raiser), Key for mentalis' push, Skull for the others (nasalis, upper
   // lip, zygomaticus minor). Others: Skull (unused).
   PullLine line;
   // Lid: the eye's corners (outer, inner), where the margin is held: the
