@@ -96,6 +96,17 @@ const std::vector<MuscleDef> kTable = {
     // point of its own, halfway, changed the 10k head's mesh and with it
     // its lower lip's targets.
     {"chin_raiser", K::Linear, "8.2", "2.10", nullptr, 0.225, +1, 0.20, 0.05, false, false, false, L::Surface},
+    // The inner brow lowered (not in the paper; docs/anatomy.md "Depressor
+    // supercilii"): the small muscle from the orbit's inner rim up into the
+    // inner brow's skin (with corrugator and procerus, FACS AU 4). The
+    // paper's only way down is frontalis driven backwards, a push from the
+    // hairline. Its attachment lies below the inner brow by the middle
+    // brow's height over the upper lid (4.3 over 3.1): beside the nose's
+    // root, level with the eye. Pulling along the bone, +100 % moves the
+    // brow 35 % of the fibre along its pull; 40 % turned a triangle at
+    // Song's inner eye corner.
+    {"depressor_supercilii_left", K::Linear, "4.1 + (3.1 - 4.3)", "4.1", nullptr, 0.60, +1, 0.35, 0.08, false, false, false, L::Surface},
+    {"depressor_supercilii_right", K::Linear, "4.2 + (3.2 - 4.4)", "4.2", nullptr, 0.60, +1, 0.35, 0.08, false, false, false, L::Surface},
 };
 
 struct Parser {

@@ -2,8 +2,9 @@
 // drivers this project adds: four for the lids (the palpebral part of
 // orbicularis oculi, one per lid: docs/anatomy.md "The lids"), two that
 // push the lips out (docs/anatomy.md "Lip protrusion"), two that flare
-// the nose's wings (docs/anatomy.md "Nostril dilators") and one that raises
-// the chin (docs/anatomy.md "Chin raiser").
+// the nose's wings (docs/anatomy.md "Nostril dilators"), one that raises
+// the chin (docs/anatomy.md "Chin raiser") and two that lower the inner
+// brows (docs/anatomy.md "Depressor supercilii").
 //
 // Key points are written as in the paper, affine combinations of FDP
 // positions: "11.1 + 1/6 (11.3 - 11.1)". parse_keypoint() turns one into
@@ -78,8 +79,9 @@ struct MuscleDef {
   bool essential;
   // Linear: its line of action (PullLine): Surface for the muscles along the
   // bone (frontalis, corrugator, zygomaticus major, risorius, depressor
-  // anguli, the chin raiser), Key for mentalis' push, Skull for the others (nasalis, upper
-  // lip, zygomaticus minor). Others: Skull (unused).
+  // anguli, the chin raiser, depressor supercilii), Key for mentalis' push,
+  // Skull for the others (nasalis, upper lip, zygomaticus minor). Others:
+  // Skull (unused).
   PullLine line;
   // Lid: the eye's corners (outer, inner), where the margin is held: the
   // load fades to nothing there. Others: nullptr.
@@ -97,7 +99,8 @@ struct MuscleDef {
 // right, then Table 2), then the four lid drivers (upper left, upper right,
 // lower left, lower right), then the two lip protrusion drivers (upper,
 // lower) and the two nostril dilators (left, right): linear muscles that
-// push; last the chin raiser, a linear muscle that pulls.
+// push; last the chin raiser and the two depressores supercilii (left,
+// right), linear muscles that pull.
 const std::vector<MuscleDef> &muscle_table();
 // "linear", "sphincter", "lid".
 const char *muscle_kind_name(MuscleKind kind);

@@ -100,8 +100,15 @@ std::vector<FapMapping> make_table() {
   add(29, D::Pupil, 300, {}, {}, pupil);
   add(30, D::Pupil, 300, {}, {}, pupil);
   // ---- group 4: eyebrows ----
-  add(31, D::Muscles, 200, {{"frontalis_inner_left", 100}}, {{"frontalis_inner_left", -100}}, "");
-  add(32, D::Muscles, 200, {{"frontalis_inner_right", 100}}, {{"frontalis_inner_right", -100}}, "");
+  // The inner brow lowered: depressor supercilii pulls it down from below
+  // while frontalis, driven backwards, pushes from above. Frontalis alone
+  // took Song's inner brow 26 % of the reference down (its brows sit 5.6
+  // units over the lids, the reference asks 5.0) and the reference heads'
+  // at 2.8-2.9 times its range (docs/anatomy.md "Depressor supercilii").
+  add(31, D::Muscles, 200, {{"frontalis_inner_left", 100}},
+      {{"frontalis_inner_left", -100}, {"depressor_supercilii_left", 100}}, "");
+  add(32, D::Muscles, 200, {{"frontalis_inner_right", 100}},
+      {{"frontalis_inner_right", -100}, {"depressor_supercilii_right", 100}}, "");
   add(33, D::Muscles, 150, {{"frontalis_major_left", 100}}, {{"frontalis_major_left", -100}}, "");
   add(34, D::Muscles, 150, {{"frontalis_major_right", 100}}, {{"frontalis_major_right", -100}}, "");
   add(35, D::Muscles, 110, {{"frontalis_outer_left", 100}}, {{"frontalis_outer_left", -100}}, "");
@@ -243,7 +250,9 @@ std::vector<HighLevelMapping> make_high_level_table() {
   add(true, 2, 0,
       {{"frontalis_inner", 80}, {"corrugator", 50}, {"depressor_anguli", 100}, {"mentalis", 50}},
       "sadness: inner brows up and together, corners down, chin raised");
-  add(true, 3, 0, {{"corrugator", 100}, {"orbicularis_oculi", 40}, {"orbicularis_oris", 50}, {"mentalis", 40}},
+  add(true, 3, 0,
+      {{"corrugator", 100}, {"depressor_supercilii", 60}, {"orbicularis_oculi", 40}, {"orbicularis_oris", 50},
+       {"mentalis", 40}},
       "anger: brows down and together, eyes narrowed, lips pressed");
   add(true, 4, 80,
       {{"frontalis_inner", 100}, {"frontalis_major", 50}, {"corrugator", 40}, {"risorius", 70},

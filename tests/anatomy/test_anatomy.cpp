@@ -177,22 +177,24 @@ int penetrating_nodes(const SkinModel &s, const Eigen::MatrixXd &X, double slack
 
 TEST(MuscleTable, TwentyFiveMusclesWithParsableKeyPoints) {
   const auto &t = muscle_table();
-  ASSERT_EQ(t.size(), 34u)
-      << "the paper's 25, four lid drivers, two lip protrusion drivers, two nostril dilators, the chin raiser";
+  ASSERT_EQ(t.size(), 36u) << "the paper's 25, four lid drivers, two lip protrusion drivers, two nostril dilators, "
+                               "the chin raiser, two depressores supercilii";
   int linear = 0, sphincter = 0;
   for (const MuscleDef &d : t) {
     const long row = &d - t.data();
     const bool paper = row < kPaperMuscles, lid = row >= kPaperMuscles && row < kPaperMuscles + 4;
     EXPECT_EQ(d.kind == MuscleKind::Lid, lid) << d.name;
     EXPECT_EQ(d.corner_outer != nullptr, lid) << d.name;
-    if (std::string(d.name) == "chin_raiser") {
-      // Mentalis' pull on the chin's skin: a linear muscle along the bone,
-      // the last row.
-      EXPECT_EQ(row + 1, static_cast<long>(t.size()));
+    const std::string name = d.name;
+    if (name == "chin_raiser" || name.rfind("depressor_supercilii_", 0) == 0) {
+      // Mentalis' pull on the chin's skin, then the inner brows' depressors
+      // (left, right): linear muscles along the bone, the last rows.
+      const long last = static_cast<long>(t.size()) - 1;
+      EXPECT_EQ(row, name == "chin_raiser" ? last - 2 : name == "depressor_supercilii_left" ? last - 1 : last);
       EXPECT_EQ(d.kind, MuscleKind::Linear);
       EXPECT_EQ(d.sense, +1);
       EXPECT_EQ(d.line, PullLine::Surface);
-      EXPECT_STREQ(d.insertion_or_minor, "2.10");
+      EXPECT_STREQ(d.insertion_or_minor, name == "chin_raiser" ? "2.10" : row == last ? "4.2" : "4.1");
     } else if (!paper && !lid) {
       // The lip protrusion drivers and the nostril dilators: linear muscles
       // that push (like mentalis) from a key point, on the tissue's whole
@@ -627,6 +629,29 @@ TEST(Physics, EachMuscleMovesItsRegionTheWayAnatomySays) {
     EXPECT_LT(std::abs(d.x()), 0.1 * d.y()) << "on the midline";
     EXPECT_LT(upper.norm(), 0.2 * d.y()) << "the upper lip stays";
     EXPECT_EQ(inverted_elements(m.tissue, X), 0);
+    EXPECT_EQ(penetrating_nodes(m.tissue, X, 1e-9), 0);
+    EXPECT_TRUE(X.allFinite());
+  }
+  {
+    // Depressor supercilii takes the inner brow (4.1) down, more down than
+    // in, out or back, and leaves the outer brow and the other side
+    // (docs/anatomy.md, "Depressor supercilii").
+    const Eigen::MatrixXd X = contract(m, "depressor_supercilii_left", t);
+    const Eigen::Vector3d d = moved(m, X, "4.1");
+    const double outer = moved(m, X, "4.5").norm(), other = moved(m, X, "4.2").norm();
+    std::printf("depressor_supercilii_left: 4.1 down %.3f mm, sideways %.3f mm, forward %.3f mm; 4.5 moves %.3f mm, "
+                "4.2 %.3f mm\n", mm(-d.y()), mm(d.x()), mm(d.z()), mm(outer), mm(other));
+    EXPECT_LT(d.y(), -0.2e-3) << "depressor supercilii lowers the inner brow";
+    EXPECT_LT(std::abs(d.x()), 0.5 * -d.y()) << "down, not in or out";
+    EXPECT_LT(std::abs(d.z()), 0.5 * -d.y()) << "down the brow, not into or out of it";
+    EXPECT_LT(outer, 0.2 * -d.y()) << "the outer brow stays";
+    EXPECT_LT(other, 0.1 * -d.y()) << "the other brow stays";
+    // Not inverted_elements: on this head the slabs in the crease between
+    // the inner brow and the eye (1-5 % of the mean tetrahedron) turn under
+    // any pull that lowers the brow, at tenths of a millimetre: 5 here, 6
+    // for frontalis driven backwards, 4 for corrugator at this tension.
+    // WithTheCollapseFloorNoSlabTurnsAtTheFullRange checks it with the
+    // floor, as for every muscle.
     EXPECT_EQ(penetrating_nodes(m.tissue, X, 1e-9), 0);
     EXPECT_TRUE(X.allFinite());
   }
