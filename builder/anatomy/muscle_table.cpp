@@ -103,7 +103,7 @@ const std::vector<MuscleDef> kTable = {
     // hairline. Its attachment lies below the inner brow by the middle
     // brow's height over the upper lid (4.3 over 3.1): beside the nose's
     // root, level with the eye. Pulling along the bone, +100 % moves the
-    // brow 35 % of the fibre along its pull; 40 % turned a triangle at
+    // brow 35 % of the fibre along its pull; 45 % turned a triangle at
     // Song's inner eye corner.
     {"depressor_supercilii_left", K::Linear, "4.1 + (3.1 - 4.3)", "4.1", nullptr, 0.60, +1, 0.35, 0.08, false, false, false, L::Surface},
     {"depressor_supercilii_right", K::Linear, "4.2 + (3.2 - 4.4)", "4.2", nullptr, 0.60, +1, 0.35, 0.08, false, false, false, L::Surface},
