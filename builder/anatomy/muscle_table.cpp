@@ -107,6 +107,16 @@ const std::vector<MuscleDef> kTable = {
     // Song's inner eye corner.
     {"depressor_supercilii_left", K::Linear, "4.1 + (3.1 - 4.3)", "4.1", nullptr, 0.60, +1, 0.35, 0.08, false, false, false, L::Surface},
     {"depressor_supercilii_right", K::Linear, "4.2 + (3.2 - 4.4)", "4.2", nullptr, 0.60, +1, 0.35, 0.08, false, false, false, L::Surface},
+    // The lower lip lowered (not in the paper; docs/anatomy.md "Depressor
+    // labii inferioris"): the muscle from the mandible below the lip up
+    // into the lower lip's skin (FACS AU 16), which the paper leaves to
+    // mentalis driven backwards, a push. Attached below the outer lower
+    // lip's middle (8.7) by the lip's height over the chin boss (8.2 over
+    // 2.10), it pulls toward that point on the chin's skin: along the bone
+    // the lip's edge went back into the mouth. Used by the outer lower lip's
+    // FAPs only (fap_mapping.cpp).
+    {"depressor_labii_left", K::Linear, "8.7 + (2.10 - 8.2)", "8.7", nullptr, 0.40, +1, 0.35, 0.08, false, false, false, L::Key},
+    {"depressor_labii_right", K::Linear, "8.8 + (2.10 - 8.2)", "8.8", nullptr, 0.40, +1, 0.35, 0.08, false, false, false, L::Key},
 };
 
 struct Parser {

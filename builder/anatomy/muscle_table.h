@@ -3,8 +3,9 @@
 // orbicularis oculi, one per lid: docs/anatomy.md "The lids"), two that
 // push the lips out (docs/anatomy.md "Lip protrusion"), two that flare
 // the nose's wings (docs/anatomy.md "Nostril dilators"), one that raises
-// the chin (docs/anatomy.md "Chin raiser") and two that lower the inner
-// brows (docs/anatomy.md "Depressor supercilii").
+// the chin (docs/anatomy.md "Chin raiser"), two that lower the inner
+// brows (docs/anatomy.md "Depressor supercilii") and two that lower the
+// lower lip (docs/anatomy.md "Depressor labii inferioris").
 //
 // Key points are written as in the paper, affine combinations of FDP
 // positions: "11.1 + 1/6 (11.3 - 11.1)". parse_keypoint() turns one into
@@ -35,7 +36,9 @@ enum class MuscleKind { Linear, Sphincter, Lid };
 //            vertex: a muscle lying along the bone under the skin, whose
 //            fibre wraps over the skull;
 //   Key      straight toward the attachment's key point itself, on the
-//            skin's surface where the FDPs are: a push from below the skin.
+//            skin's surface where the FDPs are: a push from below the skin,
+//            or a pull toward a point on the skin that stands forward of
+//            the insertion (the lower lip turned out as it comes down).
 enum class PullLine { Skull, Surface, Key };
 
 // One row of Table 1 or 2 plus the constants the paper leaves to the
@@ -79,9 +82,10 @@ struct MuscleDef {
   bool essential;
   // Linear: its line of action (PullLine): Surface for the muscles along the
   // bone (frontalis, corrugator, zygomaticus major, risorius, depressor
-  // anguli, the chin raiser, depressor supercilii), Key for mentalis' push,
-  // Skull for the others (nasalis, upper lip, zygomaticus minor). Others:
-  // Skull (unused).
+  // anguli, the chin raiser, depressor supercilii), Key for the pushes
+  // (mentalis, the lip protrusion drivers, the nostril dilators) and
+  // depressor labii's pull, Skull for the others (nasalis, upper lip,
+  // zygomaticus minor). Others: Skull (unused).
   PullLine line;
   // Lid: the eye's corners (outer, inner), where the margin is held: the
   // load fades to nothing there. Others: nullptr.

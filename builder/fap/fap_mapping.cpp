@@ -13,6 +13,7 @@ namespace afmb {
 namespace {
 
 using D = FapDriver;
+using Group = std::vector<FapContraction>;
 
 // Contraction signs follow muscle_table.cpp: a positive upper lip lowers the
 // upper lip and a positive mentalis raises the lower one, as the paper's
@@ -42,20 +43,34 @@ std::vector<FapMapping> make_table() {
   // controls bend with them (formats/afm.md, RIGD knots).
   t.back().farther = {640, 1024};
   // Inner lip (2.x) and outer lip (8.x) FAPs use the same groups: the lip
-  // moves as one; the FDP measured differs.
+  // moves as one; the FDP measured differs. Except the lower lip lowered:
+  // on the outer lip, depressor labii inferioris pulls it down toward the
+  // chin while mentalis, driven backwards, pushes. Mentalis alone took
+  // Song's 8.7 62 % of the reference down and the generated heads' 87-88 %;
+  // with the depressors all three reach it. The inner lip's FDPs keep
+  // mentalis alone: with the depressors Song's skin folded before 2.3 came
+  // down 35 % (docs/anatomy.md, "Depressor labii inferioris").
   for (int outer = 0; outer < 2; ++outer) {
     const int o = outer ? 47 : 0;  // 4 -> 51, 5 -> 52, ... 13 -> 60
     const char *io = outer ? "outer lip" : "inner lip";
+    auto lowered = [outer](Group push, Group pull) {
+      if (outer) push.insert(push.end(), pull.begin(), pull.end());
+      return push;
+    };
     add(4 + o, D::Muscles, 100, {{"upper_lip_left", 100}, {"upper_lip_right", 100}},
         {{"upper_lip_left", -100}, {"upper_lip_right", -100}}, io);
     add(5 + o, D::Muscles, 350, {{"mentalis_left", 100}, {"mentalis_right", 100}},
-        {{"mentalis_left", -100}, {"mentalis_right", -100}}, io);
+        lowered({{"mentalis_left", -100}, {"mentalis_right", -100}},
+                {{"depressor_labii_left", 100}, {"depressor_labii_right", 100}}),
+        io);
     add(6 + o, D::Muscles, 70, {{"risorius_left", 100}}, {{"orbicularis_oris", 100}}, io);
     add(7 + o, D::Muscles, 70, {{"risorius_right", 100}}, {{"orbicularis_oris", 100}}, io);
     add(8 + o, D::Muscles, 120, {{"upper_lip_left", 100}}, {{"upper_lip_left", -100}}, io);
     add(9 + o, D::Muscles, 120, {{"upper_lip_right", 100}}, {{"upper_lip_right", -100}}, io);
-    add(10 + o, D::Muscles, 350, {{"mentalis_left", 100}}, {{"mentalis_left", -100}}, io);
-    add(11 + o, D::Muscles, 350, {{"mentalis_right", 100}}, {{"mentalis_right", -100}}, io);
+    add(10 + o, D::Muscles, 350, {{"mentalis_left", 100}},
+        lowered({{"mentalis_left", -100}}, {{"depressor_labii_left", 100}}), io);
+    add(11 + o, D::Muscles, 350, {{"mentalis_right", 100}},
+        lowered({{"mentalis_right", -100}}, {{"depressor_labii_right", 100}}), io);
     add(12 + o, D::Muscles, 150, {{"zygomaticus_major_left", 100}}, {{"depressor_anguli_left", 100}}, io);
     add(13 + o, D::Muscles, 150, {{"zygomaticus_major_right", 100}}, {{"depressor_anguli_right", 100}}, io);
   }

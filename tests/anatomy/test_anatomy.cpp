@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <array>
+#include <iterator>
 #include <cmath>
 #include <map>
 #include <memory>
@@ -177,16 +178,21 @@ int penetrating_nodes(const SkinModel &s, const Eigen::MatrixXd &X, double slack
 
 TEST(MuscleTable, TwentyFiveMusclesWithParsableKeyPoints) {
   const auto &t = muscle_table();
-  ASSERT_EQ(t.size(), 36u) << "the paper's 25, four lid drivers, two lip protrusion drivers, two nostril dilators, "
-                               "the chin raiser, two depressores supercilii";
-  // The last rows: mentalis' pull on the chin's skin, then the inner brows'
-  // depressors, linear muscles that pull along the bone.
+  ASSERT_EQ(t.size(), 38u) << "the paper's 25, four lid drivers, two lip protrusion drivers, two nostril dilators, "
+                               "the chin raiser, two depressores supercilii, two depressores labii";
+  // The last rows: mentalis' pull on the chin's skin and the inner brows'
+  // depressors, linear muscles that pull along the bone, then the lower
+  // lip's depressors, which pull toward their attachment on the chin's skin.
   struct Puller {
     const char *name, *insertion;
+    PullLine line;
   };
-  const Puller pullers[] = {
-      {"chin_raiser", "2.10"}, {"depressor_supercilii_left", "4.1"}, {"depressor_supercilii_right", "4.2"}};
-  const long first_puller = static_cast<long>(t.size()) - 3;
+  const Puller pullers[] = {{"chin_raiser", "2.10", PullLine::Surface},
+                            {"depressor_supercilii_left", "4.1", PullLine::Surface},
+                            {"depressor_supercilii_right", "4.2", PullLine::Surface},
+                            {"depressor_labii_left", "8.7", PullLine::Key},
+                            {"depressor_labii_right", "8.8", PullLine::Key}};
+  const long first_puller = static_cast<long>(t.size()) - static_cast<long>(std::size(pullers));
   int linear = 0, sphincter = 0;
   for (const MuscleDef &d : t) {
     const long row = &d - t.data();
@@ -199,7 +205,7 @@ TEST(MuscleTable, TwentyFiveMusclesWithParsableKeyPoints) {
       EXPECT_EQ(name, p.name);
       EXPECT_EQ(d.kind, MuscleKind::Linear) << name;
       EXPECT_EQ(d.sense, +1) << name;
-      EXPECT_EQ(d.line, PullLine::Surface) << name;
+      EXPECT_EQ(d.line, p.line) << name;
       EXPECT_STREQ(d.insertion_or_minor, p.insertion) << name;
     } else if (!paper && !lid) {
       // The lip protrusion drivers and the nostril dilators: linear muscles
@@ -637,28 +643,53 @@ TEST(Physics, EachMuscleMovesItsRegionTheWayAnatomySays) {
     EXPECT_EQ(penetrating_nodes(m.tissue, X, 1e-9), 0);
     EXPECT_TRUE(X.allFinite());
   }
+  // A depressor takes its FDP down, more down than in or out, leaves the
+  // FDPs `near` and `far` (at most `near_share` and `far_share` of the
+  // drop) and sends no node into the skull. Returns the FDP's motion and
+  // the pose.
+  auto depressor = [&](const char *name, const char *fdp, const char *near, double near_share, const char *far,
+                       double far_share, Eigen::MatrixXd *pose) {
+    *pose = contract(m, name, t);
+    const Eigen::MatrixXd &X = *pose;
+    const Eigen::Vector3d d = moved(m, X, fdp);
+    const double n = moved(m, X, near).norm(), f = moved(m, X, far).norm();
+    std::printf("%s: %s down %.3f mm, sideways %.3f mm, forward %.3f mm; %s moves %.3f mm, %s %.3f mm\n", name, fdp,
+                mm(-d.y()), mm(d.x()), mm(d.z()), near, mm(n), far, mm(f));
+    EXPECT_LT(d.y(), -0.2e-3) << name << " lowers " << fdp;
+    EXPECT_LT(std::abs(d.x()), 0.5 * -d.y()) << name << ": down, not in or out";
+    EXPECT_LT(n, near_share * -d.y()) << name << ": " << near << " stays";
+    EXPECT_LT(f, far_share * -d.y()) << name << ": " << far << " stays";
+    EXPECT_EQ(penetrating_nodes(m.tissue, X, 1e-9), 0) << name;
+    EXPECT_TRUE(X.allFinite()) << name;
+    return d;
+  };
   {
-    // Depressor supercilii takes the inner brow (4.1) down, more down than
-    // in, out or back, and leaves the outer brow and the other side
-    // (docs/anatomy.md, "Depressor supercilii").
-    const Eigen::MatrixXd X = contract(m, "depressor_supercilii_left", t);
-    const Eigen::Vector3d d = moved(m, X, "4.1");
-    const double outer = moved(m, X, "4.5").norm(), other = moved(m, X, "4.2").norm();
-    std::printf("depressor_supercilii_left: 4.1 down %.3f mm, sideways %.3f mm, forward %.3f mm; 4.5 moves %.3f mm, "
-                "4.2 %.3f mm\n", mm(-d.y()), mm(d.x()), mm(d.z()), mm(outer), mm(other));
-    EXPECT_LT(d.y(), -0.2e-3) << "depressor supercilii lowers the inner brow";
-    EXPECT_LT(std::abs(d.x()), 0.5 * -d.y()) << "down, not in or out";
+    // Depressor supercilii takes the inner brow (4.1) down, not back, and
+    // leaves the outer brow (4.5) and the other side (docs/anatomy.md,
+    // "Depressor supercilii").
+    Eigen::MatrixXd X;
+    const Eigen::Vector3d d = depressor("depressor_supercilii_left", "4.1", "4.5", 0.2, "4.2", 0.1, &X);
     EXPECT_LT(std::abs(d.z()), 0.5 * -d.y()) << "down the brow, not into or out of it";
-    EXPECT_LT(outer, 0.2 * -d.y()) << "the outer brow stays";
-    EXPECT_LT(other, 0.1 * -d.y()) << "the other brow stays";
     // Not inverted_elements: on this head the slabs in the crease between
     // the inner brow and the eye (1-5 % of the mean tetrahedron) turn under
     // any pull that lowers the brow, at tenths of a millimetre: 5 here, 6
     // for frontalis driven backwards, 4 for corrugator at this tension.
     // WithTheCollapseFloorNoSlabTurnsAtTheFullRange checks it with the
     // floor, as for every muscle.
-    EXPECT_EQ(penetrating_nodes(m.tissue, X, 1e-9), 0);
-    EXPECT_TRUE(X.allFinite());
+  }
+  {
+    // Depressor labii inferioris takes the lower lip's left middle (8.7)
+    // down and leaves the upper lip (8.1) and, mostly, the lower lip's
+    // other side (8.8) (docs/anatomy.md, "Depressor labii inferioris"). It
+    // pulls toward its attachment on the chin's skin, which stands forward
+    // of the lip's lower edge: the lip turns out a little as it comes down
+    // (measured: forward 0.64 of the drop; along the bone it went back into
+    // the mouth).
+    Eigen::MatrixXd X;
+    const Eigen::Vector3d d = depressor("depressor_labii_left", "8.7", "8.1", 0.2, "8.8", 0.5, &X);
+    EXPECT_GT(d.z(), 0.0) << "the lip turns out, not into the mouth";
+    EXPECT_LT(d.z(), 0.8 * -d.y()) << "down more than out";
+    EXPECT_EQ(inverted_elements(m.tissue, X), 0);
   }
   {
     const Eigen::MatrixXd X = contract(m, "depressor_anguli_left", t);

@@ -509,5 +509,5 @@ TEST(SimMesh, SongsMusclesAttachAsOnTheSkinAndAlikeOnBothSides) {
     EXPECT_NEAR(l.length, r.length, 0.01 * l.length) << l.name;
     ++pairs;
   }
-  EXPECT_EQ(pairs, 13);  // the paper's 11 linear pairs, the nostril dilators, the depressores supercilii
+  EXPECT_EQ(pairs, 14);  // the paper's 11 linear pairs, the nostril dilators, the depressores supercilii and labii
 }
