@@ -7,8 +7,8 @@
 
 #include <algorithm>
 #include <array>
-#include <iterator>
 #include <cmath>
+#include <iterator>
 #include <map>
 #include <memory>
 
@@ -643,7 +643,7 @@ TEST(Physics, EachMuscleMovesItsRegionTheWayAnatomySays) {
     EXPECT_EQ(penetrating_nodes(m.tissue, X, 1e-9), 0);
     EXPECT_TRUE(X.allFinite());
   }
-  // A depressor takes its FDP down, more down than in or out, leaves the
+  // A depressor takes its FDP down, more down than sideways, leaves the
   // FDPs `near` and `far` (at most `near_share` and `far_share` of the
   // drop) and sends no node into the skull. Returns the FDP's motion and
   // the pose.
@@ -656,7 +656,7 @@ TEST(Physics, EachMuscleMovesItsRegionTheWayAnatomySays) {
     std::printf("%s: %s down %.3f mm, sideways %.3f mm, forward %.3f mm; %s moves %.3f mm, %s %.3f mm\n", name, fdp,
                 mm(-d.y()), mm(d.x()), mm(d.z()), near, mm(n), far, mm(f));
     EXPECT_LT(d.y(), -0.2e-3) << name << " lowers " << fdp;
-    EXPECT_LT(std::abs(d.x()), 0.5 * -d.y()) << name << ": down, not in or out";
+    EXPECT_LT(std::abs(d.x()), 0.5 * -d.y()) << name << ": down, not sideways";
     EXPECT_LT(n, near_share * -d.y()) << name << ": " << near << " stays";
     EXPECT_LT(f, far_share * -d.y()) << name << ": " << far << " stays";
     EXPECT_EQ(penetrating_nodes(m.tissue, X, 1e-9), 0) << name;

@@ -2348,9 +2348,11 @@ TEST(FapSynthesis, SongsInnerBrowComesDownMostOfItsReferenceWithoutAFold) {
 // real streams send 818 times, to -870): depressor labii inferioris pulls
 // the outer lip down toward the chin while mentalis, driven backwards,
 // pushes it (fap_mapping.cpp). Made with the lower lip's other outer FAPs,
-// it reaches the reference, -350, as in the whole AFM. Mentalis alone
-// reached 62 % there and held it to the reference (docs/anatomy.md,
-// "Depressor labii inferioris").
+// it reaches the reference, -350, as in the whole AFM, and folds none of
+// the lifted skin (the whole AFM's positive side, which splits its skin
+// with the inner lip's FAPs too, turns 3 triangles: README, "Open").
+// Mentalis alone reached 61 % here and held it to the reference (62 %;
+// docs/anatomy.md, "Depressor labii inferioris").
 TEST(FapSynthesis, SongsLowerLipComesDownToItsReferenceWithoutAFold) {
   AFM_REQUIRE_SHARED_DATA();
   EXPECT_EQ(expect_song_side_lowered(57, {52, 57, 58}, 0.9), 1) << "the target at -350";
