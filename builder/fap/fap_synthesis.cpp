@@ -20,8 +20,8 @@
 #include "fap/fap_mapping.h"
 #include "fap/fap_partition.h"
 #include "fap/jaw_lips.h"
-#include "fap/teeth_clearance.h"
 #include "fap/steer.h"
+#include "fap/teeth_clearance.h"
 #include "fap/untangle.h"
 
 namespace afmb {
