@@ -45,12 +45,13 @@ static void usage(FILE *out) {
           "by the sum over those FAPs of value x FAPU along the FAP's direction (the\n"
           "MPEG-4 rule). Where that prescription is at least MNS0 / 20 long, the FDP's\n"
           "played motion (the head's rotation left out) is compared with it: per FDP\n"
-          "group, the median share of the prescription reached along it, the median\n"
-          "distance from it relative to its length, and the 90th percentile share\n"
-          "(100 %% is exact; above it, the face overshoots the stream). Motion that no\n"
-          "FAP of an FDP prescribes counts as played: the jaw's opening (FAP 3 names\n"
-          "only the chin, 2.1) carries the lower lip's FDPs forward as the jaw glides,\n"
-          "though not down (the jaw does not open the mouth).\n"
+          "group, then per FDP (with the FAPs that name it), the median share of the\n"
+          "prescription reached along it, the median distance from it relative to its\n"
+          "length, and the 90th percentile share (100 %% is exact; above it, the face\n"
+          "overshoots the stream). Motion that no FAP of an FDP prescribes counts as\n"
+          "played: the jaw's opening (FAP 3 names only the chin, 2.1) carries the lower\n"
+          "lip's FDPs forward as the jaw glides, though not down (the jaw does not open\n"
+          "the mouth).\n"
           "\n"
           "--folds: in every frame, the skin's triangles (parts of kind skin) whose\n"
           "normal points against their rest normal, the head's rotation left out;\n"
@@ -166,17 +167,23 @@ static int write_obj(const char *dir, uint32_t index, const afm_doc *doc, const 
   return 1;
 }
 
-/* --fdp-motion (see usage): samples per FDP group 1..11. */
+/* --fdp-motion (see usage): samples per FDP group 1..11, and per FDP. */
 typedef struct fdp_motion {
   uint32_t point[AFM_FAP_COUNT + 1]; /* per FAP 3..68: its FDP's index in meta.fdps, or AFM_NONE */
   double *share[12], *error[12];     /* per group: along share and relative distance */
   uint32_t count[12], capacity[12]; /* per group: samples taken, room */
+  /* Per FDP (index into meta.fdps): room for `frames` samples each, at
+   * [i * frames], and the samples taken. */
+  double *fdp_share, *fdp_error;
+  uint32_t *fdp_count, frames;
 } fdp_motion;
 
 /* Which FDP each distance FAP names (the first point of that id on a
- * vertex), and room for `frames` samples of every FDP in each group. */
+ * vertex), and room for `frames` samples of every FDP in each group and of
+ * each FDP. */
 static int fdp_motion_init(fdp_motion *fm, const afm_doc *doc, uint32_t frames) {
   uint32_t f, i, g;
+  const size_t fdps = doc->meta.fdp_count;
   memset(fm, 0, sizeof *fm);
   for (f = 0; f <= AFM_FAP_COUNT; ++f) fm->point[f] = AFM_NONE;
   for (f = 3; f <= AFM_FAP_COUNT; ++f) {
@@ -200,12 +207,18 @@ static int fdp_motion_init(fdp_motion *fm, const afm_doc *doc, uint32_t frames) 
     fm->error[g] = (double *)malloc(fm->capacity[g] * sizeof(double));
     if (!fm->share[g] || !fm->error[g]) return 0;
   }
-  return 1;
+  if (!fdps || !frames) return 1;
+  fm->frames = frames;
+  fm->fdp_count = (uint32_t *)calloc(fdps, sizeof(uint32_t));
+  fm->fdp_share = (double *)malloc(fdps * frames * sizeof(double));
+  fm->fdp_error = (double *)malloc(fdps * frames * sizeof(double));
+  return fm->fdp_count && fm->fdp_share && fm->fdp_error;
 }
 
 static void fdp_motion_free(fdp_motion *fm) {
   int g;
   for (g = 0; g < 12; ++g) free(fm->share[g]), free(fm->error[g]);
+  free(fm->fdp_share), free(fm->fdp_error), free(fm->fdp_count);
 }
 
 /* One pose: the values of states a and b blended by t (Q16), the player's
@@ -240,15 +253,20 @@ static void fdp_motion_add(fdp_motion *fm, const afm_doc *doc, const afm_player 
     for (k = 0; k < 3; ++k) along += got[k] * want[k] / len, off += (got[k] - want[k]) * (got[k] - want[k]);
     fm->share[pt->group][fm->count[pt->group]] = along / len;
     fm->error[pt->group][fm->count[pt->group]++] = sqrt(off) / len;
+    if (fm->fdp_count && fm->fdp_count[i] < fm->frames) {
+      const size_t at = (size_t)i * fm->frames + fm->fdp_count[i]++;
+      fm->fdp_share[at] = along / len;
+      fm->fdp_error[at] = sqrt(off) / len;
+    }
   }
 }
 
 static int compare_double(const void *a, const void *b);
 
-static void fdp_motion_print(fdp_motion *fm) {
+static void fdp_motion_print(fdp_motion *fm, const afm_doc *doc) {
   static const char *names[12] = {"",      "",     "inner lip, chin, jaw", "eyes",  "brows", "cheeks",
                                   "tongue", "head", "outer lip",            "nose",  "ears",  "hair"};
-  uint32_t g, n;
+  uint32_t g, n, i, f;
   printf("FDP motion against the stream's prescription (where it is at least MNS0 / 20):\n");
   printf("  group                    samples  reached (median)  off by (median)  reached (90th pct)\n");
   for (g = 1; g < 12; ++g) {
@@ -258,6 +276,33 @@ static void fdp_motion_print(fdp_motion *fm) {
     qsort(fm->error[g], n, sizeof(double), compare_double);
     printf("  %2u %-21s %8lu  %15.1f %%  %14.1f %%  %16.1f %%\n", (unsigned)g, names[g], (unsigned long)n,
            100 * fm->share[g][n / 2], 100 * fm->error[g][n / 2], 100 * fm->share[g][n * 9 / 10]);
+  }
+  if (!fm->fdp_count) return;
+  /* The same per FDP, with the FAPs that name it: which point of a group
+   * misses, and whose motion it is. */
+  printf("  FDP    FAPs             samples  reached (median)  off by (median)  reached (90th pct)\n");
+  for (i = 0; i < 256 * 256; ++i) {
+    const afm_fdp_point *pt = NULL;
+    uint32_t j;
+    /* In FDP order (group, then index): the file's order is its own. */
+    for (j = 0; j < doc->meta.fdp_count && !pt; ++j)
+      if (doc->meta.fdps[j].group == i / 256 && doc->meta.fdps[j].index == i % 256 && fm->fdp_count[j])
+        pt = &doc->meta.fdps[j];
+    if (!pt) continue;
+    j = (uint32_t)(pt - doc->meta.fdps);
+    double *share = fm->fdp_share + (size_t)j * fm->frames, *error = fm->fdp_error + (size_t)j * fm->frames;
+    char id[16], faps[64];
+    size_t used = 0;
+    n = fm->fdp_count[j];
+    faps[0] = 0;
+    for (f = 3; f <= AFM_FAP_COUNT; ++f)
+      if (fm->point[f] == j && used + 5 < sizeof faps)
+        used += (size_t)snprintf(faps + used, sizeof faps - used, "%s%lu", used ? " " : "", (unsigned long)f);
+    snprintf(id, sizeof id, "%u.%u", (unsigned)pt->group, (unsigned)pt->index);
+    qsort(share, n, sizeof(double), compare_double);
+    qsort(error, n, sizeof(double), compare_double);
+    printf("  %-6s %-15s %8lu  %15.1f %%  %14.1f %%  %16.1f %%\n", id, faps, (unsigned long)n, 100 * share[n / 2],
+           100 * error[n / 2], 100 * share[n * 9 / 10]);
   }
 }
 
@@ -580,7 +625,7 @@ int main(int argc, char **argv) {
     printf("stream: %lu values clamped, %lu with fractions rounded\n", (unsigned long)fap_stats.clamped,
            (unsigned long)fap_stats.rounded);
   }
-  if (motion) fdp_motion_print(&fm);
+  if (motion) fdp_motion_print(&fm, doc);
   if (folding) folds_print(&fo, rendered);
   status = 0;
 done:

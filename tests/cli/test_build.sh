@@ -113,6 +113,12 @@ done
 r=$(reached "$tmp/alone.txt" 2)
 awk -v r="$r" 'BEGIN { exit !(r >= 45 && r <= 55) }' ||
   fail "FAP 12 alone moves the corner by ${r:-no} % of its prescription, not half: $(cat "$tmp/alone.txt")"
+# The table per FDP: the corner 2.4, named by FAPs 6 and 12, is group 2's
+# only point the stream moves, so its row is the group's. (Its FAPs stand
+# between the FDP and the samples: the reached share follows the samples.)
+r4=$(awk '$1 == "2.4" { for (i = 2; i <= NF; ++i) if ($i ~ /^[0-9]+$/ && $(i + 2) == "%") { print $(i + 1); exit } }' "$tmp/alone.txt")
+grep -q '^  2\.4  *6 12  ' "$tmp/alone.txt" && [ "$r4" = "$r" ] ||
+  fail "afm-play --fdp-motion: FDP 2.4's row (FAPs 6 12) does not give group 2's ${r:-no} %: $(cat "$tmp/alone.txt")"
 expect_error "bad simulation size" 2 "at least 200, or full" - -- "$bin" "$tmp/h2.wrl" "$tmp/h2.fdp" --sim-vertices 50
 
 # Lips that are one surface, as a scan's: the generated head with its closed
