@@ -22,14 +22,14 @@ FapPartition partition_shared_targets(const Eigen::MatrixXd &X, const Eigen::Mat
     return targets[k].vertex >= 0 && targets[k].vertex < X.rows() && !targets[k].muscles.empty();
   };
   // Linked: the groups share a muscle contracted the same way, or one's
-  // target moves the other's FDP along the other's motion by more than
-  // kFapOverlap of the other's own target there.
+  // target moves the other's FDP, in any direction, by more than
+  // kFapOverlap of the other's own motion there along its direction.
   auto overlaps = [&targets](size_t i, size_t j) {
     const SharingTarget &ti = targets[i], &tj = targets[j];
     if (!ti.displacement || !tj.displacement || ti.fap == tj.fap) return false;
     const Eigen::Vector3d along = tj.side * tj.direction;
     const double own = tj.displacement->row(tj.vertex).dot(along.transpose());
-    const double cross = ti.displacement->row(tj.vertex).dot(along.transpose());
+    const double cross = ti.displacement->row(tj.vertex).norm();
     return own > 0 && cross > kFapOverlap * own;
   };
   for (size_t a = 0; a < n; ++a)

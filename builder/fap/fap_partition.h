@@ -15,9 +15,17 @@
 // The rule: two targets are linked when their muscle groups share a muscle
 // contracted the same way (a positive-side target of one FAP and a
 // negative-side one of another may be linked: both are poses of that
-// muscle), or when one's target moves the other's FDP along the other's
-// motion by more than kFapOverlap of the other's own target there (the
-// brows; 41's zygomatici and the lower lip). A linked set (a connected
+// muscle), or when one's target moves the other's FDP, in any direction, by
+// more than kFapOverlap of the other's own target's motion there along its
+// FAP's direction (the brows; 41's zygomatici and the lower lip). Any
+// direction: a stream sending both moves that FDP by the spill, and a spill
+// across the other FAP's direction takes the FDP off its axis as surely as
+// one along it overshoots. Counted along the direction only, Song's brow
+// squeeze (37, corrugator) was left alone, and it carried the middle brow
+// 4.3 inward 1.5 times as far as the inner brow 4.1 it is defined on
+// (Candide-3's block: half as far), a horizontal motion that no FAP of 4.3
+// has: Xface's hate.fap, which sends 37 with 33, missed its brows' motion by
+// 384 % (median; afm-play --fdp-motion), now by 9 %. A linked set (a connected
 // component) splits the skin by Shepard's inverse-distance weights on its
 // members' FDPs,
 //
@@ -59,7 +67,9 @@ namespace afmb {
 // Measured with afm-play --fdp-motion on seven of the real streams, summing
 // the median distance from the prescription over streams and FDP groups:
 // 16 % less than linking by shared muscles alone on Song, 10 % less on the
-// 2k head (a half or a tenth of the own motion not tried).
+// 2k head. With the spill counted in any direction, on Song's whole AFM
+// and all twelve real streams: 0.1 1679, 0.25 1690, 0.5 1689, 1.0 1711
+// (2344 counted along the direction at 0.25).
 constexpr double kFapOverlap = 0.25;
 
 struct SharingTarget {

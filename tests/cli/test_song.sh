@@ -249,6 +249,24 @@ if [ "${AFM_CONFIG:-release}" != sanitize ]; then
         fail "Song, fear.fap: FDP group $group is a median $2 % of the prescription away (over 40 %: the lower lip stops at its reach?)"
     done
   done
+  # Each FDP on its own (afm-play --fdp-motion's second table): Xface's
+  # hate.fap sends the brows squeezed (FAPs 37, 38 at 70) with the middle
+  # brows lowered (33, 34 at -35). The squeeze's corrugator inserts at the
+  # middle brow, and once carried it inward 3.3 units, 3.8 times its own
+  # FAP's prescription (384 %, median); now the brows' FAPs split the skin
+  # in any direction they move it (builder/fap/fap_partition.h) and it stays
+  # on its prescription.
+  "$bin/afm-play" "$tmp/song.afm" "$AFM_SHARED_DIR/data/fap/xface/hate.fap" --quiet --fdp-motion \
+    >"$tmp/motion_hate.txt" 2>&1 || fail "afm-play --fdp-motion failed on Song with hate.fap: $(tail -n 3 "$tmp/motion_hate.txt")"
+  for fdp in 4.3 4.4; do
+    # samples, reached (median), off by (median)
+    set -- $(awk -v p="$fdp" '$1 == p && $1 ~ /\./ { for (i = 2; i <= NF; ++i) if ($i ~ /^[0-9]+$/ && $(i + 2) == "%") { print $i, $(i + 1), $(i + 3); exit } }' \
+      "$tmp/motion_hate.txt")
+    [ $# -eq 3 ] || fail "afm-play --fdp-motion on hate.fap: no line for FDP $fdp: $(cat "$tmp/motion_hate.txt")"
+    echo "Song, hate.fap, FDP $fdp: $1 samples, median $2 %, median distance $3 %"
+    awk -v d="$3" 'BEGIN { exit !(d <= 20) }' ||
+      fail "Song, hate.fap: the middle brow $fdp is a median $3 % of its prescription away (over 20 %: the squeeze moves it again?)"
+  done
 fi
 
 "$bin/afm-render" "$tmp/song.afm" "$stream" -o "$tmp/frames" --frames 0:60 --size 320x400 --closeup --textures "$song" \

@@ -22,10 +22,12 @@
 #include <string>
 #include <vector>
 
+#include "core/fapu.h"
 #include "fap/fap_mapping.h"
 #include "fap/fap_synthesis.h"
 #include "fap/fidelity_report.h"
 #include "../common/reference_model.h"
+#include "../common/song_model.h"
 #include "../common/test_paths.h"
 
 using namespace afmb;
@@ -297,6 +299,69 @@ TEST(Candide3, TargetsMoveTheWayCandidesFapBlocksDo) {
   EXPECT_EQ(past, 6);
   EXPECT_NE(fidelity_table(*syn).find("; 6 in-betweens past the lower lip's reach are made from the jaw's target"),
             std::string::npos);
+}
+
+// Candide-3's squeeze (FAP 37) moves the inner brow, FAP 37's FDP, and half
+// as far the middle brow's two vertices, those of its FAP 33 block. Song's
+// target may carry its middle brow 4.3 no further, against its inner brow
+// 4.1, than that. The corrugator inserts at 4.3 and had pulled it inward
+// 1.5 times as far as 4.1, a motion that no FAP of 4.3 has, until the split
+// of shared skin counted a spill across another FAP's direction
+// (fap_partition.h). Made with the left brow's other FAPs, which share its
+// skin, as the whole AFM does.
+TEST(Candide3, SongsBrowSqueezeMovesTheMiddleBrowNoFurtherThanCandidesBlock) {
+  AFM_REQUIRE_SHARED_DATA();
+  Candide c;
+  ASSERT_TRUE(read_candide(afmtest::shared_data("faces/candide3/candide3.wfm"), &c));
+  const CandideBlock *squeeze = nullptr, *middle = nullptr;
+  for (const CandideBlock &k : c.faps) {
+    if (k.fap == 37) squeeze = &k;
+    if (k.fap == 33) middle = &k;
+  }
+  ASSERT_TRUE(squeeze && middle) << "Candide-3 has no FAP 37 or FAP 33 block";
+  // The squeeze's largest motion off the middle brow (its FDP) and on it:
+  // Candide's share for the middle brow.
+  double inner = 0, on_middle = 0;
+  for (const auto &[cv, dir] : squeeze->moves) {
+    const int v = cv;
+    const bool is_middle =
+        std::any_of(middle->moves.begin(), middle->moves.end(), [v](const auto &mv) { return mv.first == v; });
+    double &most = is_middle ? on_middle : inner;
+    most = std::max(most, dir.norm());
+  }
+  ASSERT_GT(inner, 0);
+  ASSERT_GT(on_middle, 0) << "Candide's squeeze moves none of the middle brow's vertices";
+  const double share = on_middle / inner;
+
+  FapSynthesisOptions o;
+  o.only = {31, 33, 35, 37};
+  const afmtest::SongOnSimMesh song = afmtest::song_on_sim_mesh(calibration_needs(o).muscles);
+  ASSERT_FALSE(HasFailure());
+  const SimFaceModel &sm = song.built;
+  o.sim = &sm.sim;
+  Expected<FapSynthesis> syn = synthesize_faps(sm.scene, sm.model, o);
+  ASSERT_TRUE(syn.is_ok()) << syn.status().message();
+  const FdpPoint *p41 = song.face.fdps.find(FdpId{4, 1}, sm.sim.skin);
+  const FdpPoint *p43 = song.face.fdps.find(FdpId{4, 3}, sm.sim.skin);
+  ASSERT_TRUE(p41 && p41->vertex >= 0 && p43 && p43->vertex >= 0);
+  const afm_fap_info *info = afm_fap(37);
+  const Eigen::Vector3d dir(info->direction[0], info->direction[1], info->direction[2]);
+  const double unit = fapu_distance(sm.model.fapu, info->unit) / 1024.0;
+  int checked = 0;
+  size_t next = 0;
+  for (const FapOutcome &out : syn->outcomes) {
+    if (!out.made) continue;
+    const Eigen::MatrixXd &D = syn->targets[next++].displacement[static_cast<size_t>(sm.sim.skin)];
+    if (out.number != 37 || out.side < 0 || out.holds) continue;
+    ++checked;
+    const Eigen::Vector3d d41 = D.row(p41->vertex).transpose(), d43 = D.row(p43->vertex).transpose();
+    std::printf("FAP 37 at %d: 4.1 moves %.2f units (%.2f toward the midline, of %.2f), 4.3 %.2f; Candide's "
+                "share %.2f\n",
+                out.reference, d41.norm(), d41.dot(dir), out.reference * unit, d43.norm(), share);
+    EXPECT_GT(d41.dot(dir), 0.9 * out.reference * unit) << out.message;
+    EXPECT_LE(d43.norm(), share * d41.norm()) << "the middle brow moves further than Candide-3's block has it";
+  }
+  EXPECT_EQ(checked, 1) << "FAP 37's positive target";
 }
 
 }  // namespace

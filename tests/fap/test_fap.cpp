@@ -38,10 +38,13 @@
 #include "io/load_face.h"
 #include "refhead/refhead.h"
 #include "../common/reference_model.h"
+#include "../common/song_model.h"
 #include "../common/surface_rays.h"
 #include "../common/test_paths.h"
 
 using namespace afmb;
+using afmtest::song_on_sim_mesh;
+using afmtest::SongOnSimMesh;
 
 namespace {
 
@@ -1861,10 +1864,12 @@ TEST(FapPartition, LinkedTargetsSplitThePointsAndEachFapCountsOnce) {
   }
 }
 
-// Targets of different muscles are linked when one moves the other's FDP
-// along the other's direction by over kFapOverlap of the other's own motion;
-// and the distances run along the mesh: two lips that touch at one point
-// (two vertices there, as on the reference head) are far apart.
+// Targets of different muscles are linked when one moves the other's FDP,
+// in any direction, by over kFapOverlap of the other's own motion along its
+// direction (a sideways spill too: Song's brow squeeze carried the middle
+// brow inward, across FAP 33's up-down axis); and the distances run along
+// the mesh: two lips that touch at one point (two vertices there, as on the
+// reference head) are far apart.
 TEST(FapPartition, OverlappingTargetsLinkAndDistancesRunAlongTheMesh) {
   // Two strips of three vertices, the upper one's left end on the lower
   // one's left end (the mouth's corner is one vertex, its middle two).
@@ -1886,7 +1891,10 @@ TEST(FapPartition, OverlappingTargetsLinkAndDistancesRunAlongTheMesh) {
   t[0].displacement = &upper, t[1].displacement = &lower;
   FapPartition p = partition_shared_targets(X, F, t);
   EXPECT_NE(p.component[0], p.component[1]) << "a fifth of the other's motion is below the overlap";
-  upper(3, 1) = 0.3;
+  upper(3, 0) = 0.25;  // and a quarter of it sideways: 0.32 in all
+  p = partition_shared_targets(X, F, t);
+  EXPECT_EQ(p.component[0], p.component[1]) << "a spill across the other's direction counts too";
+  upper(3, 0) = 0, upper(3, 1) = 0.3;
   p = partition_shared_targets(X, F, t);
   ASSERT_EQ(p.component[0], p.component[1]);
   // Along the mesh the middles are 4 apart (round the corner), not 0.
@@ -2077,32 +2085,6 @@ TEST(FapSynthesis, TargetsMadeOnACoarserSimulationMeshMatchTheSkins) {
   refused = encode_afm(bad, AFM_PROFILE_RAW);
   ASSERT_FALSE(refused.is_ok());
   EXPECT_NE(refused.status().message().find("not finite"), std::string::npos) << refused.status().message();
-}
-
-// Song as afm-build models it, on its default simulation mesh, with only
-// `muscles` calibrated (none when empty) and the jaw when `jaw`; the loaded
-// face (its whole skin) beside it.
-struct SongOnSimMesh {
-  LoadedFace face;
-  SimFaceModel built;
-};
-SongOnSimMesh song_on_sim_mesh(const std::vector<std::string> &muscles, bool jaw = false,
-                               int vertices = kDefaultSimVertices) {
-  SongOnSimMesh out;
-  Expected<LoadedFace> f = load_face(afmtest::shared_data("faces/song/song.WRL"),
-                                     afmtest::shared_data("faces/song/song.fdp"), LoadOptions{}, nullptr);
-  EXPECT_TRUE(f.is_ok()) << f.status().message();
-  if (!f.is_ok()) return out;
-  out.face = std::move(*f);
-  FaceModelOptions fo;
-  fo.calibrate_only = muscles;
-  fo.calibrate_muscles = !muscles.empty();
-  fo.calibrate_jaw = jaw;
-  Expected<SimFaceModel> m =
-      build_sim_face_model(out.face.scene, out.face.fdps, SimMeshOptions{vertices}, fo);
-  EXPECT_TRUE(m.is_ok()) << m.status().message();
-  if (m.is_ok()) out.built = std::move(*m);
-  return out;
 }
 
 // Song on afm-build's simulation mesh, its eye sphincters calibrated.

@@ -1,0 +1,27 @@
+#include "song_model.h"
+
+#include <gtest/gtest.h>
+
+#include "test_paths.h"
+
+namespace afmtest {
+
+SongOnSimMesh song_on_sim_mesh(const std::vector<std::string> &muscles, bool jaw, int vertices) {
+  SongOnSimMesh out;
+  afmb::Expected<afmb::LoadedFace> f = afmb::load_face(
+      shared_data("faces/song/song.WRL"), shared_data("faces/song/song.fdp"), afmb::LoadOptions{}, nullptr);
+  EXPECT_TRUE(f.is_ok()) << f.status().message();
+  if (!f.is_ok()) return out;
+  out.face = std::move(*f);
+  afmb::FaceModelOptions fo;
+  fo.calibrate_only = muscles;
+  fo.calibrate_muscles = !muscles.empty();
+  fo.calibrate_jaw = jaw;
+  afmb::Expected<afmb::SimFaceModel> m =
+      afmb::build_sim_face_model(out.face.scene, out.face.fdps, afmb::SimMeshOptions{vertices}, fo);
+  EXPECT_TRUE(m.is_ok()) << m.status().message();
+  if (m.is_ok()) out.built = std::move(*m);
+  return out;
+}
+
+}  // namespace afmtest
