@@ -172,18 +172,18 @@ typedef struct fdp_motion {
   uint32_t point[AFM_FAP_COUNT + 1]; /* per FAP 3..68: its FDP's index in meta.fdps, or AFM_NONE */
   double *share[12], *error[12];     /* per group: along share and relative distance */
   uint32_t count[12], capacity[12]; /* per group: samples taken, room */
-  /* Per FDP (index into meta.fdps): room for `frames` samples each, at
-   * [i * frames], and the samples taken. */
+  /* Per FDP that a FAP names: its slot (per index into meta.fdps, or
+   * AFM_NONE), room for `frames` samples at [slot * frames], and the samples
+   * taken. */
+  uint32_t *slot, *fdp_count, frames;
   double *fdp_share, *fdp_error;
-  uint32_t *fdp_count, frames;
 } fdp_motion;
 
 /* Which FDP each distance FAP names (the first point of that id on a
  * vertex), and room for `frames` samples of every FDP in each group and of
  * each FDP. */
 static int fdp_motion_init(fdp_motion *fm, const afm_doc *doc, uint32_t frames) {
-  uint32_t f, i, g;
-  const size_t fdps = doc->meta.fdp_count;
+  uint32_t f, i, g, slots = 0;
   memset(fm, 0, sizeof *fm);
   for (f = 0; f <= AFM_FAP_COUNT; ++f) fm->point[f] = AFM_NONE;
   for (f = 3; f <= AFM_FAP_COUNT; ++f) {
@@ -207,18 +207,26 @@ static int fdp_motion_init(fdp_motion *fm, const afm_doc *doc, uint32_t frames) 
     fm->error[g] = (double *)malloc(fm->capacity[g] * sizeof(double));
     if (!fm->share[g] || !fm->error[g]) return 0;
   }
-  if (!fdps || !frames) return 1;
+  if (!doc->meta.fdp_count) return 1;
   fm->frames = frames;
-  fm->fdp_count = (uint32_t *)calloc(fdps, sizeof(uint32_t));
-  fm->fdp_share = (double *)malloc(fdps * frames * sizeof(double));
-  fm->fdp_error = (double *)malloc(fdps * frames * sizeof(double));
+  fm->slot = (uint32_t *)malloc(doc->meta.fdp_count * sizeof(uint32_t));
+  if (!fm->slot) return 0;
+  for (i = 0; i < doc->meta.fdp_count; ++i) {
+    fm->slot[i] = AFM_NONE;
+    for (f = 3; f <= AFM_FAP_COUNT && fm->slot[i] == AFM_NONE; ++f)
+      if (fm->point[f] == i) fm->slot[i] = slots++;
+  }
+  if (!slots) return 1;
+  fm->fdp_count = (uint32_t *)calloc(slots, sizeof(uint32_t));
+  fm->fdp_share = (double *)malloc((size_t)slots * frames * sizeof(double));
+  fm->fdp_error = (double *)malloc((size_t)slots * frames * sizeof(double));
   return fm->fdp_count && fm->fdp_share && fm->fdp_error;
 }
 
 static void fdp_motion_free(fdp_motion *fm) {
   int g;
   for (g = 0; g < 12; ++g) free(fm->share[g]), free(fm->error[g]);
-  free(fm->fdp_share), free(fm->fdp_error), free(fm->fdp_count);
+  free(fm->fdp_share), free(fm->fdp_error), free(fm->fdp_count), free(fm->slot);
 }
 
 /* One pose: the values of states a and b blended by t (Q16), the player's
@@ -253,8 +261,8 @@ static void fdp_motion_add(fdp_motion *fm, const afm_doc *doc, const afm_player 
     for (k = 0; k < 3; ++k) along += got[k] * want[k] / len, off += (got[k] - want[k]) * (got[k] - want[k]);
     fm->share[pt->group][fm->count[pt->group]] = along / len;
     fm->error[pt->group][fm->count[pt->group]++] = sqrt(off) / len;
-    if (fm->fdp_count && fm->fdp_count[i] < fm->frames) {
-      const size_t at = (size_t)i * fm->frames + fm->fdp_count[i]++;
+    if (fm->fdp_count && fm->slot[i] != AFM_NONE && fm->fdp_count[fm->slot[i]] < fm->frames) {
+      const size_t at = (size_t)fm->slot[i] * fm->frames + fm->fdp_count[fm->slot[i]]++;
       fm->fdp_share[at] = along / len;
       fm->fdp_error[at] = sqrt(off) / len;
     }
@@ -286,14 +294,16 @@ static void fdp_motion_print(fdp_motion *fm, const afm_doc *doc) {
     uint32_t j;
     /* In FDP order (group, then index): the file's order is its own. */
     for (j = 0; j < doc->meta.fdp_count && !pt; ++j)
-      if (doc->meta.fdps[j].group == i / 256 && doc->meta.fdps[j].index == i % 256 && fm->fdp_count[j])
+      if (doc->meta.fdps[j].group == i / 256 && doc->meta.fdps[j].index == i % 256 && fm->slot[j] != AFM_NONE &&
+          fm->fdp_count[fm->slot[j]])
         pt = &doc->meta.fdps[j];
     if (!pt) continue;
     j = (uint32_t)(pt - doc->meta.fdps);
-    double *share = fm->fdp_share + (size_t)j * fm->frames, *error = fm->fdp_error + (size_t)j * fm->frames;
+    double *share = fm->fdp_share + (size_t)fm->slot[j] * fm->frames;
+    double *error = fm->fdp_error + (size_t)fm->slot[j] * fm->frames;
     char id[16], faps[64];
     size_t used = 0;
-    n = fm->fdp_count[j];
+    n = fm->fdp_count[fm->slot[j]];
     faps[0] = 0;
     for (f = 3; f <= AFM_FAP_COUNT; ++f)
       if (fm->point[f] == j && used + 5 < sizeof faps)
