@@ -1,10 +1,13 @@
 #include "core/orient.h"
 
+#include <afm/mpeg4.h>
+
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <vector>
 
 namespace afmb {
@@ -322,6 +325,47 @@ Status check_orientation(const FdpSet &bound) {
   else
     msg += "; " + d.message;
   return Status::error(msg);
+}
+
+std::vector<std::string> fdp_order_notes(const FdpSet &bound) {
+  // (first, second): first above second (y), or on the face's left of it (x).
+  struct Pair {
+    FdpId first, second;
+  };
+  static const Pair kAbove[] = {
+      {{9, 3}, {8, 1}}, {{8, 1}, {2, 2}}, {{2, 2}, {2, 3}},  {{2, 3}, {8, 2}}, {{8, 2}, {2, 10}}, {{2, 10}, {2, 1}},
+      {{8, 5}, {2, 6}}, {{8, 6}, {2, 7}}, {{2, 6}, {2, 8}},  {{2, 7}, {2, 9}}, {{2, 8}, {8, 7}},  {{2, 9}, {8, 8}},
+      {{3, 1}, {3, 3}}, {{3, 2}, {3, 4}}, {{4, 3}, {3, 1}},  {{4, 4}, {3, 2}}, {{3, 5}, {9, 3}},  {{3, 6}, {9, 3}},
+  };
+  static const Pair kLeft[] = {
+      {{3, 5}, {3, 6}},  {{3, 1}, {3, 2}}, {{3, 3}, {3, 4}}, {{3, 7}, {3, 11}}, {{3, 8}, {3, 12}}, {{4, 1}, {4, 2}},
+      {{4, 5}, {4, 3}},  {{4, 3}, {4, 1}}, {{4, 2}, {4, 4}}, {{4, 4}, {4, 6}},  {{5, 1}, {5, 2}},  {{5, 3}, {5, 4}},
+      {{2, 4}, {2, 5}},  {{2, 4}, {2, 6}}, {{2, 6}, {2, 7}}, {{2, 7}, {2, 5}},  {{2, 4}, {2, 8}},  {{2, 8}, {2, 9}},
+      {{2, 9}, {2, 5}},  {{8, 3}, {8, 4}}, {{8, 3}, {8, 5}}, {{8, 5}, {8, 6}},  {{8, 6}, {8, 4}},  {{8, 3}, {8, 7}},
+      {{8, 7}, {8, 8}},  {{8, 8}, {8, 4}}, {{9, 1}, {9, 2}}, {{2, 11}, {2, 12}}, {{2, 13}, {2, 14}},
+  };
+  // The extent of the FDPs along each axis, the first usable point of each.
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const FdpPoint &p : bound.points)
+    if (lookup(bound, p.id) == &p) lo = lo.cwiseMin(p.pos), hi = hi.cwiseMax(p.pos);
+  std::vector<std::string> notes;
+  auto describe = [](FdpId id) {  // "2.10 (Chin boss)"
+    const afm_fdp_info *info = afm_fdp_find(id.group, id.index);
+    return id_str(id) + (info ? std::string(" (") + info->description + ")" : std::string());
+  };
+  auto check = [&](const Pair &pair, int axis, const char *wrong, const char *right) {
+    const FdpPoint *a = lookup(bound, pair.first), *b = lookup(bound, pair.second);
+    if (!a || !b || !(hi[axis] > lo[axis])) return;
+    const double by = b->pos[axis] - a->pos[axis];
+    if (!(by > 0.01 * (hi[axis] - lo[axis]))) return;
+    char far[32];
+    std::snprintf(far, sizeof far, "%.3g", by);
+    notes.push_back("FDP " + describe(pair.first) + " lies " + far + " " + wrong + " " + describe(pair.second) +
+                    "; MPEG-4 puts it " + right + ": the file may have them swapped or misplaced");
+  };
+  for (const Pair &pair : kAbove) check(pair, 1, "below", "above");
+  for (const Pair &pair : kLeft) check(pair, 0, "on the face's right of", "on its left");
+  return notes;
 }
 
 Expected<Orientation> detect_orientation(const FdpSet &bound) {

@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "core/fdp.h"
 #include "core/scene.h"
@@ -44,6 +45,29 @@ Expected<Orientation> parse_orientation(std::string_view spec);
 // missing. A failure names the failed check with the vectors measured and
 // the --orient value detect_orientation() finds, or why there is none.
 Status check_orientation(const FdpSet &bound);
+
+// After check_orientation: the pairs of FDPs that MPEG-4's neutral face
+// puts in an order, one above the other (the chin boss 2.10 above the
+// bottom of the chin 2.1, the upper lip's points above the lower's, the
+// upper lids above the lower, the brows above the lids) or one on the face's
+// left of the other (each left point of its right twin, the brows' and the
+// lips' points from the outer corner in), that the bound set has the other
+// way round by more than a hundredth of the FDPs' extent along that axis.
+// One line per such pair, naming both FDPs with their MPEG-4 descriptions
+// and how far (model units): "FDP 2.10 (Chin boss) lies 2.37 below 2.1
+// (Bottom of the chin); MPEG-4 puts it above: the file may have them
+// swapped or misplaced". Empty when every pair present is in order. Each
+// FDP's first usable point counts (as above). A note, not an error: the
+// mesh is built as the file says, but a FAP moves its misplaced FDP's skin
+// (on Song, FAP 18 raises 2.10 and carries 2.1 up with it, against the
+// jaw's FAP 3).
+//
+// The lips' midpoints 2.6, 2.8, 8.5 and 8.7 are on the face's left, where
+// the FAP table names them (FAPs 8, 10, 55 and 57 move the left middle of
+// their lip contour) and where Candide-3 and Song place them, although the
+// FDP list's wording ("midpoint between 2.2 and 2.5", the right corner) has
+// them on the right.
+std::vector<std::string> fdp_order_notes(const FdpSet &bound);
 
 // The signed permutation that passes every check, preferring proper
 // rotations (the best score when several pass). When only a mirror passes,

@@ -47,6 +47,8 @@ Expected<LoadedFace> load_face(const std::string &mesh_path, const std::string &
     if (log) log->push_back("orientation: applied " + o->spec());
   }
   if (Status s = check_orientation(face.fdps); !s) return s.wrap(mesh_path);
+  if (log)
+    for (const std::string &n : fdp_order_notes(face.fdps)) log->push_back("note: " + fdp_path + ": " + n);
 
   guess_part_kinds(face.scene);
   const double tolerance = kFreeFdpShare * scene_diagonal(face.scene);

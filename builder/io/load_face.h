@@ -36,7 +36,9 @@ constexpr double kFreeFdpShare = 0.005;
 // lips apart, repairs coincident skin vertices and
 // checks the skin. `log` gets one line per thing done on the user's behalf
 // ("orientation: applied x,z,-y", "FDPs: 84 free points attached ...",
-// "repaired: ..."). Errors name the file and
+// "repaired: ...") and one per pair of FDPs out of MPEG-4's order
+// ("note: song.fdp: FDP 2.10 (Chin boss) lies 2.37 below 2.1 ...":
+// fdp_order_notes, orient.h). Errors name the file and
 // line, part or FDP; an orientation error is wrapped with the mesh's path.
 Expected<LoadedFace> load_face(const std::string &mesh_path, const std::string &fdp_path,
                                const LoadOptions &options, std::vector<std::string> *log);

@@ -33,6 +33,11 @@ grep -q "^note: on the .*simulation mesh:.*tried" "$tmp/build.txt" &&
 made=$(sed -n 's/^targets: \([0-9]*\) made.*/\1/p' "$tmp/build.txt")
 [ -n "$made" ] && [ "$made" -ge "$want" ] || fail "Song: ${made:-no} targets made, expected at least $want"
 grep -q "^e1  *joy  *63 " "$tmp/build.txt" || fail "Song: no joy target: $(grep -c . "$tmp/build.txt") lines"
+# Song's file puts the chin boss below the bottom of the chin, the MPEG-4
+# order reversed (core/orient.h, fdp_order_notes): the build says so, once.
+[ "$(grep -c '^note: .*song\.fdp: FDP ' "$tmp/build.txt")" -eq 1 ] &&
+  grep -q '^note: .*song\.fdp: FDP 2\.10 (Chin boss) lies [0-9.]* below 2\.1 (Bottom of the chin); MPEG-4 puts it above' \
+    "$tmp/build.txt" || fail "Song: not the one note on its FDPs' order: $(grep '^note: ' "$tmp/build.txt")"
 # Song has a tongue part with FDPs 6.1-6.4: its FAPs are made, exact at the FDP.
 for f in "43  *shift_tongue_tip" "47  *tongue_roll"; do
   grep -q "^$f .* 0\.00% .*the tongue's own motion" "$tmp/build.txt" ||

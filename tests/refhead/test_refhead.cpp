@@ -18,6 +18,7 @@
 #include "afm/render.h"
 #include "core/fapu.h"
 #include "core/fdp.h"
+#include "core/orient.h"
 #include "io/fdp_io.h"
 #include "io/vrml.h"
 #include "refhead/refhead.h"
@@ -342,6 +343,9 @@ TEST(RefHeadFdps, GeometryFollowsTheNeutralFrame) {
     EXPECT_LT(pos(h, "9.10").z(), pos(h, "2.2").z());
     EXPECT_LT(pos(h, "6.1").z(), pos(h, "9.11").z());
     EXPECT_GT(pos(h, "6.3").x(), pos(h, "6.4").x());
+    // And every pair the import checks (core/orient.h, fdp_order_notes).
+    const std::vector<std::string> notes = fdp_order_notes(h.fdps);
+    EXPECT_TRUE(notes.empty()) << notes.front();
   }
 }
 
