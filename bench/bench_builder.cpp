@@ -47,6 +47,40 @@ double now() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
+// afm-build's job on its default simulation mesh (sim_mesh.h) with the
+// model options `fo`: the model, the FAP targets and the draco AFM.
+struct WholeAfm {
+  Expected<SimFaceModel> model = Status::error("not built");
+  double seconds = 0, targets_seconds = 0;  // the whole job; the targets alone
+  size_t made = 0, tried = 0, under = 0;    // targets made, attempted, short of their reference
+  double off = 0;                           // off-axis median, percent
+  Expected<std::vector<uint8_t>> bytes = Status::error("not built");
+};
+WholeAfm whole_afm(const Scene &scene, const FdpSet &fdps, const FaceModelOptions &fo) {
+  WholeAfm w;
+  const double t0 = now();
+  w.model = build_sim_face_model(scene, fdps, SimMeshOptions{kDefaultSimVertices}, fo);
+  if (!w.model) {
+    w.bytes = w.model.status();
+    return w;
+  }
+  FapSynthesisOptions so;
+  so.sim = &w.model->sim;
+  const double t1 = now();
+  Expected<FapSynthesis> st = synthesize_faps(w.model->scene, w.model->model, so);
+  w.targets_seconds = now() - t1;
+  if (!st) {
+    w.bytes = st.status();
+    return w;
+  }
+  for (const FapOutcome &o : st->outcomes) w.under += o.made && o.reached < 1;
+  w.made = st->targets.size(), w.tried = st->outcomes.size();
+  w.off = off_median(*st);
+  w.bytes = encode_afm(fap_afm_content(scene, fdps, w.model->model, std::move(*st)), AFM_PROFILE_DRACO);
+  w.seconds = now() - t0;
+  return w;
+}
+
 // Returns false when the model does not build.
 bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
   std::printf("-- %s\n", label);
@@ -80,74 +114,52 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
   const double whole_skin = now() - t0;
 
   // afm-build's default: the same job on the simulation mesh (sim_mesh.h).
-  {
-    const double t2 = now();
-    Expected<SimFaceModel> s = build_sim_face_model(scene, fdps, SimMeshOptions{kDefaultSimVertices}, FaceModelOptions{});
-    FapSynthesisOptions so;
-    if (s) so.sim = &s->sim;
-    const double t3 = now();
-    Expected<FapSynthesis> st = s ? synthesize_faps(s->scene, s->model, so) : Expected<FapSynthesis>(s.status());
-    const double t_steered = now() - t3;
-    if (st) {
-      const double off_steered = off_median(*st);
-      size_t under = 0;
-      for (const FapOutcome &o : st->outcomes) under += o.made && o.reached < 1;
-      Expected<std::vector<uint8_t>> bytes =
-          encode_afm(fap_afm_content(scene, fdps, s->model, std::move(*st)), AFM_PROFILE_DRACO);
-      const double t = now() - t2;
-      std::printf("on the simulation mesh (%zu vertices, %zu retries): whole AFM %.2f s, %.1fx faster than on the "
-                  "skin; AFM %s; %zu targets under-reach\n",
-                  s->sim.kept.size(), s->notes.size(), t, whole_skin / t,
-                  bytes ? (std::to_string(bytes->size()) + " bytes").c_str() : bytes.status().message().c_str(), under);
-      // The same targets with each group alone (no helpers steering the
-      // FDP onto the FAP's direction, fap/steer.h): what the steering costs.
-      FapSynthesisOptions alone = so;
-      alone.steer = false;
-      const double t4 = now();
-      Expected<FapSynthesis> sa = synthesize_faps(s->scene, s->model, alone);
-      const double t_alone = now() - t4;
-      if (sa)
-        std::printf("on the simulation mesh, FAP targets with helpers %.2f s (off-axis median %.1f %%), the groups "
-                    "alone %.2f s (%.1f %%): %.2fx the time\n",
-                    t_steered, off_steered, t_alone, off_median(*sa), t_steered / t_alone);
-    } else {
-      std::printf("on the simulation mesh: failed: %s\n", st.status().message().c_str());
-    }
+  const WholeAfm by_default = whole_afm(scene, fdps, FaceModelOptions{});
+  if (by_default.bytes) {
+    const SimFaceModel &s = *by_default.model;
+    std::printf("on the simulation mesh (%zu vertices, %zu retries): whole AFM %.2f s, %.1fx faster than on the "
+                "skin; AFM %zu bytes; %zu targets under-reach\n",
+                s.sim.kept.size(), s.notes.size(), by_default.seconds, whole_skin / by_default.seconds,
+                by_default.bytes->size(), by_default.under);
+    // The same targets with each group alone (no helpers steering the
+    // FDP onto the FAP's direction, fap/steer.h): what the steering costs.
+    FapSynthesisOptions alone;
+    alone.sim = &s.sim;
+    alone.steer = false;
+    const double t4 = now();
+    Expected<FapSynthesis> sa = synthesize_faps(s.scene, s.model, alone);
+    const double t_alone = now() - t4;
+    if (sa)
+      std::printf("on the simulation mesh, FAP targets with helpers %.2f s (off-axis median %.1f %%), the groups "
+                  "alone %.2f s (%.1f %%): %.2fx the time\n",
+                  by_default.targets_seconds, by_default.off, t_alone, off_median(*sa),
+                  by_default.targets_seconds / t_alone);
+  } else {
+    std::printf("on the simulation mesh: failed: %s\n", by_default.bytes.status().message().c_str());
   }
 
   // The whole AFM on the simulation mesh with each solver (afm-build
-  // --solver; the muscles' calibration is newton's in every run): the job
-  // issue 4's "fastest that stays stable" is about. `under`: targets whose
-  // side stops short of the table's reference (a solve that fails past the
-  // range stops it too). Per-muscle solves from rest (below) are another
-  // sample: newton-jacobi is faster at them on Song, and 10 times slower at
-  // Song's whole AFM, whose solves start from nearby poses and reuse their
-  // factorisations.
+  // --solver; the muscles' calibration is newton's in every run), the
+  // default's from the run above: the job issue 4's "fastest that stays
+  // stable" is about. `under`: targets whose side stops short of the table's
+  // reference (a solve that fails past the range stops it too). Per-muscle
+  // solves from rest (below) are another sample: newton-jacobi is faster at
+  // them on Song, and 10 times slower at Song's whole AFM, whose solves
+  // start from nearby poses and reuse their factorisations.
   std::printf("%-16s %9s %7s %7s %6s %9s\n", "whole AFM", "seconds", "ratio", "made", "under", "off-axis");
-  double default_seconds = 0;
+  const SolverKind default_kind = FaceModelOptions{}.solver.kind;
   for (SolverKind k : kSolverKinds) {
     FaceModelOptions fo;
     fo.solver.kind = k;
-    const double t5 = now();
-    Expected<SimFaceModel> s = build_sim_face_model(scene, fdps, SimMeshOptions{kDefaultSimVertices}, fo);
-    FapSynthesisOptions so;
-    if (s) so.sim = &s->sim;
-    Expected<FapSynthesis> st = s ? synthesize_faps(s->scene, s->model, so) : Expected<FapSynthesis>(s.status());
-    if (!st) {
-      std::printf("%-16s failed: %s\n", solver_name(k), st.status().message().c_str());
+    const WholeAfm other = k == default_kind ? WholeAfm{} : whole_afm(scene, fdps, fo);
+    const WholeAfm &w = k == default_kind ? by_default : other;
+    if (!w.bytes) {
+      std::printf("%-16s failed: %s\n", solver_name(k), w.bytes.status().message().c_str());
       continue;
     }
-    size_t under = 0;
-    for (const FapOutcome &o : st->outcomes) under += o.made && o.reached < 1;
-    const size_t made = st->targets.size(), tried = st->outcomes.size();
-    const double off = off_median(*st);
-    Expected<std::vector<uint8_t>> bytes =
-        encode_afm(fap_afm_content(scene, fdps, s->model, std::move(*st)), AFM_PROFILE_DRACO);
-    const double t = now() - t5;
-    if (k == FaceModelOptions{}.solver.kind) default_seconds = t;
-    std::printf("%-16s %9.2f %6.1fx %3zu/%zu %6zu %8.1f%%%s\n", solver_name(k), t,
-                default_seconds > 0 ? t / default_seconds : 1.0, made, tried, under, off,
-                bytes ? "" : "  (the AFM failed)");
+    std::printf("%-16s %9.2f %6.1fx %3zu/%zu %6zu %8.1f%%%s\n", solver_name(k), w.seconds,
+                by_default.seconds > 0 ? w.seconds / by_default.seconds : 0.0, w.made, w.tried, w.under, w.off,
+                k == default_kind ? "  (the default, above)" : "");
   }
 
   // Time to equilibrium at +100 % from rest, on V_d, factorisations included;

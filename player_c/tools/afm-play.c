@@ -167,23 +167,22 @@ static int write_obj(const char *dir, uint32_t index, const afm_doc *doc, const 
   return 1;
 }
 
-/* --fdp-motion (see usage): samples per FDP group 1..11, and per FDP. */
+/* --fdp-motion (see usage): samples per FDP that a distance FAP names; a
+ * group's figures are those of its FDPs' samples together. */
 typedef struct fdp_motion {
   uint32_t point[AFM_FAP_COUNT + 1]; /* per FAP 3..68: its FDP's index in meta.fdps, or AFM_NONE */
-  double *share[12], *error[12];     /* per group: along share and relative distance */
-  uint32_t count[12], capacity[12]; /* per group: samples taken, room */
-  /* Per FDP that a FAP names: its slot (per index into meta.fdps, or
-   * AFM_NONE), room for `frames` samples at [slot * frames], and the samples
-   * taken. */
-  uint32_t *slot, *fdp_count, frames;
-  double *fdp_share, *fdp_error;
+  uint32_t *slot;                    /* per index into meta.fdps: its samples' slot, or AFM_NONE */
+  uint32_t *count, frames;           /* per slot: samples taken, of room for `frames` */
+  double *share, *error;             /* at [slot * frames]: along share and relative distance */
+  double *gather;                    /* room for the largest group's shares, then its distances */
+  size_t most;                       /* that room: the largest group's samples (groups 1..11) */
 } fdp_motion;
 
 /* Which FDP each distance FAP names (the first point of that id on a
- * vertex), and room for `frames` samples of every FDP in each group and of
- * each FDP. */
+ * vertex), and room for `frames` samples of each of them. */
 static int fdp_motion_init(fdp_motion *fm, const afm_doc *doc, uint32_t frames) {
-  uint32_t f, i, g, slots = 0;
+  uint32_t f, i, slots = 0;
+  size_t per_group[12] = {0};
   memset(fm, 0, sizeof *fm);
   for (f = 0; f <= AFM_FAP_COUNT; ++f) fm->point[f] = AFM_NONE;
   for (f = 3; f <= AFM_FAP_COUNT; ++f) {
@@ -194,39 +193,28 @@ static int fdp_motion_init(fdp_motion *fm, const afm_doc *doc, uint32_t frames) 
       if (p->group == info->fdp_group && p->index == info->fdp_index && p->vertex != AFM_NONE) fm->point[f] = i;
     }
   }
-  /* Room per group: every frame of each FDP of the group that a FAP names. */
-  for (i = 0; i < doc->meta.fdp_count; ++i) {
-    const uint8_t group = doc->meta.fdps[i].group;
-    int named = 0;
-    for (f = 3; f <= AFM_FAP_COUNT; ++f) named |= fm->point[f] == i;
-    if (named && group < 12) fm->capacity[group] += frames;
-  }
-  for (g = 0; g < 12; ++g) {
-    if (!fm->capacity[g]) continue;
-    fm->share[g] = (double *)malloc(fm->capacity[g] * sizeof(double));
-    fm->error[g] = (double *)malloc(fm->capacity[g] * sizeof(double));
-    if (!fm->share[g] || !fm->error[g]) return 0;
-  }
   if (!doc->meta.fdp_count) return 1;
   fm->frames = frames;
   fm->slot = (uint32_t *)malloc(doc->meta.fdp_count * sizeof(uint32_t));
   if (!fm->slot) return 0;
   for (i = 0; i < doc->meta.fdp_count; ++i) {
+    const uint8_t group = doc->meta.fdps[i].group;
     fm->slot[i] = AFM_NONE;
+    if (group > 11) continue;
     for (f = 3; f <= AFM_FAP_COUNT && fm->slot[i] == AFM_NONE; ++f)
       if (fm->point[f] == i) fm->slot[i] = slots++;
+    if (fm->slot[i] != AFM_NONE && (per_group[group] += frames) > fm->most) fm->most = per_group[group];
   }
   if (!slots) return 1;
-  fm->fdp_count = (uint32_t *)calloc(slots, sizeof(uint32_t));
-  fm->fdp_share = (double *)malloc((size_t)slots * frames * sizeof(double));
-  fm->fdp_error = (double *)malloc((size_t)slots * frames * sizeof(double));
-  return fm->fdp_count && fm->fdp_share && fm->fdp_error;
+  fm->count = (uint32_t *)calloc(slots, sizeof(uint32_t));
+  fm->share = (double *)malloc((size_t)slots * frames * sizeof(double));
+  fm->error = (double *)malloc((size_t)slots * frames * sizeof(double));
+  fm->gather = (double *)malloc(2 * fm->most * sizeof(double));
+  return fm->count && fm->share && fm->error && fm->gather;
 }
 
 static void fdp_motion_free(fdp_motion *fm) {
-  int g;
-  for (g = 0; g < 12; ++g) free(fm->share[g]), free(fm->error[g]);
-  free(fm->fdp_share), free(fm->fdp_error), free(fm->fdp_count), free(fm->slot);
+  free(fm->slot), free(fm->count), free(fm->share), free(fm->error), free(fm->gather);
 }
 
 /* One pose: the values of states a and b blended by t (Q16), the player's
@@ -237,10 +225,14 @@ static void fdp_motion_add(fdp_motion *fm, const afm_doc *doc, const afm_player 
   const int32_t *x = afm_player_positions(p);
   const double limit = doc->meta.mns0 / 20.0;
   uint32_t i, f;
+  if (!fm->count) return;
   for (i = 0; i < doc->meta.fdp_count; ++i) {
     const afm_fdp_point *pt = &doc->meta.fdps[i];
+    const uint32_t slot = fm->slot[i];
     double want[3] = {0, 0, 0}, got[3], len = 0, along = 0, off = 0;
-    int named = 0, k;
+    size_t at;
+    int k;
+    if (slot == AFM_NONE || fm->count[slot] >= fm->frames) continue;
     for (f = 3; f <= AFM_FAP_COUNT; ++f) {
       const afm_fap_info *info;
       double v, unit;
@@ -249,9 +241,7 @@ static void fdp_motion_add(fdp_motion *fm, const afm_doc *doc, const afm_player 
       v = a->value[f] + (double)(b->value[f] - a->value[f]) * t / 65536.0;
       unit = afm_meta_fapu_x0(&doc->meta, info->unit) / 1024.0;
       for (k = 0; k < 3; ++k) want[k] += v * unit * info->direction[k];
-      named = 1;
     }
-    if (!named || pt->group > 11 || fm->count[pt->group] >= fm->capacity[pt->group]) continue;
     for (k = 0; k < 3; ++k) len += want[k] * want[k];
     len = sqrt(len);
     if (!(len >= limit) || limit <= 0) continue;
@@ -259,60 +249,63 @@ static void fdp_motion_add(fdp_motion *fm, const afm_doc *doc, const afm_player 
     got[1] = (double)(x[3 * pt->vertex + 1] - geo->py[pt->vertex]) * geo->step;
     got[2] = (double)(x[3 * pt->vertex + 2] - geo->pz[pt->vertex]) * geo->step;
     for (k = 0; k < 3; ++k) along += got[k] * want[k] / len, off += (got[k] - want[k]) * (got[k] - want[k]);
-    fm->share[pt->group][fm->count[pt->group]] = along / len;
-    fm->error[pt->group][fm->count[pt->group]++] = sqrt(off) / len;
-    if (fm->fdp_count && fm->slot[i] != AFM_NONE && fm->fdp_count[fm->slot[i]] < fm->frames) {
-      const size_t at = (size_t)fm->slot[i] * fm->frames + fm->fdp_count[fm->slot[i]]++;
-      fm->fdp_share[at] = along / len;
-      fm->fdp_error[at] = sqrt(off) / len;
-    }
+    at = (size_t)slot * fm->frames + fm->count[slot]++;
+    fm->share[at] = along / len;
+    fm->error[at] = sqrt(off) / len;
   }
 }
 
 static int compare_double(const void *a, const void *b);
 
+/* One table row's three figures from n samples (sorted here). */
+static void print_figures(double *share, double *error, size_t n) {
+  qsort(share, n, sizeof(double), compare_double);
+  qsort(error, n, sizeof(double), compare_double);
+  printf("%8lu  %15.1f %%  %14.1f %%  %16.1f %%\n", (unsigned long)n, 100 * share[n / 2], 100 * error[n / 2],
+         100 * share[n * 9 / 10]);
+}
+
 static void fdp_motion_print(fdp_motion *fm, const afm_doc *doc) {
   static const char *names[12] = {"",      "",     "inner lip, chin, jaw", "eyes",  "brows", "cheeks",
                                   "tongue", "head", "outer lip",            "nose",  "ears",  "hair"};
-  uint32_t g, n, i, f;
+  const afm_fdp_info *table = afm_fdp_table();
+  uint32_t g, i, j, f;
   printf("FDP motion against the stream's prescription (where it is at least MNS0 / 20):\n");
   printf("  group                    samples  reached (median)  off by (median)  reached (90th pct)\n");
+  if (!fm->count) return;
   for (g = 1; g < 12; ++g) {
-    n = fm->count[g];
+    size_t n = 0;
+    for (i = 0; i < doc->meta.fdp_count; ++i) {
+      const uint32_t slot = fm->slot[i];
+      if (slot == AFM_NONE || doc->meta.fdps[i].group != g) continue;
+      memcpy(fm->gather + n, fm->share + (size_t)slot * fm->frames, fm->count[slot] * sizeof(double));
+      memcpy(fm->gather + fm->most + n, fm->error + (size_t)slot * fm->frames, fm->count[slot] * sizeof(double));
+      n += fm->count[slot];
+    }
     if (!n) continue;
-    qsort(fm->share[g], n, sizeof(double), compare_double);
-    qsort(fm->error[g], n, sizeof(double), compare_double);
-    printf("  %2u %-21s %8lu  %15.1f %%  %14.1f %%  %16.1f %%\n", (unsigned)g, names[g], (unsigned long)n,
-           100 * fm->share[g][n / 2], 100 * fm->error[g][n / 2], 100 * fm->share[g][n * 9 / 10]);
+    printf("  %2u %-21s ", (unsigned)g, names[g]);
+    print_figures(fm->gather, fm->gather + fm->most, n);
   }
-  if (!fm->fdp_count) return;
-  /* The same per FDP, with the FAPs that name it: which point of a group
-   * misses, and whose motion it is. */
+  /* The same per FDP, in the standard's order, with the FAPs that name it:
+   * which point of a group misses, and whose motion it is. */
   printf("  FDP    FAPs             samples  reached (median)  off by (median)  reached (90th pct)\n");
-  for (i = 0; i < 256 * 256; ++i) {
-    const afm_fdp_point *pt = NULL;
-    uint32_t j;
-    /* In FDP order (group, then index): the file's order is its own. */
-    for (j = 0; j < doc->meta.fdp_count && !pt; ++j)
-      if (doc->meta.fdps[j].group == i / 256 && doc->meta.fdps[j].index == i % 256 && fm->slot[j] != AFM_NONE &&
-          fm->fdp_count[fm->slot[j]])
-        pt = &doc->meta.fdps[j];
-    if (!pt) continue;
-    j = (uint32_t)(pt - doc->meta.fdps);
-    double *share = fm->fdp_share + (size_t)fm->slot[j] * fm->frames;
-    double *error = fm->fdp_error + (size_t)fm->slot[j] * fm->frames;
+  for (i = 0; i < AFM_FDP_COUNT; ++i) {
     char id[16], faps[64];
     size_t used = 0;
-    n = fm->fdp_count[fm->slot[j]];
+    uint32_t slot = AFM_NONE;
+    /* The point of this id that the FAPs name (the first on a vertex). */
+    for (j = 0; j < doc->meta.fdp_count; ++j)
+      if (doc->meta.fdps[j].group == table[i].group && doc->meta.fdps[j].index == table[i].index &&
+          (slot = fm->slot[j]) != AFM_NONE)
+        break;
+    if (slot == AFM_NONE || !fm->count[slot]) continue;
     faps[0] = 0;
     for (f = 3; f <= AFM_FAP_COUNT; ++f)
       if (fm->point[f] == j && used + 5 < sizeof faps)
         used += (size_t)snprintf(faps + used, sizeof faps - used, "%s%lu", used ? " " : "", (unsigned long)f);
-    snprintf(id, sizeof id, "%u.%u", (unsigned)pt->group, (unsigned)pt->index);
-    qsort(share, n, sizeof(double), compare_double);
-    qsort(error, n, sizeof(double), compare_double);
-    printf("  %-6s %-15s %8lu  %15.1f %%  %14.1f %%  %16.1f %%\n", id, faps, (unsigned long)n, 100 * share[n / 2],
-           100 * error[n / 2], 100 * share[n * 9 / 10]);
+    snprintf(id, sizeof id, "%u.%u", (unsigned)table[i].group, (unsigned)table[i].index);
+    printf("  %-6s %-15s ", id, faps);
+    print_figures(fm->share + (size_t)slot * fm->frames, fm->error + (size_t)slot * fm->frames, fm->count[slot]);
   }
 }
 
