@@ -49,6 +49,13 @@ struct FapMapping {
   // The groups for a model that lacks a muscle of `positive` / `negative`
   // (empty: none; the FAP is then not made).
   std::vector<FapContraction> fallback_positive, fallback_negative;
+  // Second groups (empty: none): where the side's own group falls short of
+  // the reference (fap_synthesis.h, "Reach, then hold"), this one is tried
+  // too, and its target is kept where it takes the FDP nearer the
+  // prescribed motion (|achieved - prescribed|). For a region one muscle
+  // moves well only in part: the upper lip muscle, pushed, dents the lip at
+  // its insertion (8.10) before the lip's side (2.6) comes down half way.
+  std::vector<FapContraction> second_positive, second_negative;
   // Eyelid FAPs (19-22) act through their lid's driver (the palpebral part
   // of orbicularis oculi, muscle_table.h), which needs an eye part under the
   // lid. Without one they fall back to orbicularis oculi, which closes both

@@ -160,19 +160,31 @@ std::string fap_label(int fap, int side) {
   return std::string(info ? info->name : "fap") + (side < 0 ? " (negative)" : "");
 }
 
+// Whether the model has every muscle of group g.
+bool complete_group(const FaceModel &model, const std::vector<FapContraction> &g) {
+  for (const FapContraction &c : g)
+    if (model.find(c.muscle) < 0) return false;
+  return true;
+}
+
+// A FAP side's second group (fap_mapping.h), where the model has it: else
+// empty.
+const std::vector<FapContraction> &second_group(const FaceModel &model, const FapMapping &map, int side) {
+  static const std::vector<FapContraction> none;
+  const std::vector<FapContraction> &g = side > 0 ? map.second_positive : map.second_negative;
+  return complete_group(model, g) ? g : none;
+}
+
 // The group a FAP's side acts through: its own, or its fallback when the
 // model lacks one of its own muscles and has every fallback muscle
-// (fap_mapping.h). *fallback tells which.
+// (fap_mapping.h). *fallback tells which. With `second`, its second group.
 const std::vector<FapContraction> &fap_group(const FaceModel &model, const FapMapping &map, int side,
-                                             bool *fallback = nullptr) {
+                                             bool *fallback = nullptr, bool second = false) {
+  if (fallback) *fallback = false;
+  if (second) return second_group(model, map, side);
   const std::vector<FapContraction> &own = side > 0 ? map.positive : map.negative;
   const std::vector<FapContraction> &alt = side > 0 ? map.fallback_positive : map.fallback_negative;
-  auto complete = [&model](const std::vector<FapContraction> &g) {
-    for (const FapContraction &c : g)
-      if (model.find(c.muscle) < 0) return false;
-    return true;
-  };
-  const bool use_alt = !complete(own) && !alt.empty() && complete(alt);
+  const bool use_alt = !complete_group(model, own) && !alt.empty() && complete_group(model, alt);
   if (fallback) *fallback = use_alt;
   return use_alt ? alt : own;
 }
@@ -282,7 +294,9 @@ CalibrationNeeds calibration_needs(const FapSynthesisOptions &options) {
     if (!listed(options.only, m.fap) && !(m.driver == FapDriver::Muscles && twin_of_listed(options, m.fap))) continue;
     need.jaw |= m.driver == FapDriver::JawOpen || m.driver == FapDriver::JawThrust || m.driver == FapDriver::JawShift;
     if (m.driver != FapDriver::Muscles) continue;
-    for (const auto *g : {&m.positive, &m.negative, &m.fallback_positive, &m.fallback_negative}) add(*g);
+    for (const auto *g : {&m.positive, &m.negative, &m.fallback_positive, &m.fallback_negative, &m.second_positive,
+                          &m.second_negative})
+      add(*g);
     for (const std::string &h : m.helpers)
       if (std::find(need.muscles.begin(), need.muscles.end(), h) == need.muscles.end()) need.muscles.push_back(h);
   }
@@ -364,6 +378,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     int reference = 0;        // FAP units along `side` (> 0)
     bool in_between = false;  // one of the mapping's `farther`
     bool hidden = false;      // made only as a listed right FAP's mirror twin, not kept
+    bool second = false;      // made with the side's second group (fap_mapping.h)
   };
   const bool everything = lists_nothing(options);
   std::vector<Work> work;
@@ -923,7 +938,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     } else {
       std::vector<std::pair<int, double>> pattern;
       std::string missing;
-      for (const FapContraction &c : fap_group(model, *map, side, &fallback)) {
+      for (const FapContraction &c : fap_group(model, *map, side, &fallback, work[k].second)) {
         const int i = model.find(c.muscle);
         if (i < 0) missing += (missing.empty() ? "" : ", ") + c.muscle;
         else pattern.push_back({i, c.percent});
@@ -1197,6 +1212,62 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       options.progress(++done, static_cast<int>(work.size()),
                        work[k].high ? high_level_label(*work[k].high) : fap_label(work[k].fap->fap, work[k].side));
   });
+  // Second groups (fap_mapping.h): a side its own group left short of the
+  // reference is made again with its second group (twins as before), and
+  // the target nearer the prescribed motion is kept.
+  {
+    auto miss = [](const FapOutcome &o) { return (o.achieved - o.prescribed).norm() / o.prescribed.norm(); };
+    std::vector<size_t> retry;
+    for (size_t k : order) {
+      const FapOutcome &o = results[k].outcome;
+      if (options.second_groups && same_as[k] == k && work[k].fap && work[k].fap->driver == FapDriver::Muscles &&
+          !work[k].in_between && o.made && o.reached < 1 && o.prescribed.norm() > 0 &&
+          !second_group(model, *work[k].fap, work[k].side).empty())
+        retry.push_back(k);
+    }
+    std::vector<Result> own(retry.size());
+    std::vector<int> in_retry(work.size(), -1), after_retry(retry.size(), -1);
+    for (size_t j = 0; j < retry.size(); ++j) {
+      const size_t k = retry[j];
+      own[j] = std::move(results[k]);
+      results[k] = Result();
+      recipes[k].reset();
+      work[k].second = true;
+      in_retry[k] = static_cast<int>(j);
+    }
+    for (size_t j = 0; j < retry.size(); ++j)
+      if (const int t = twin_of[retry[j]]; t >= 0) after_retry[j] = in_retry[static_cast<size_t>(t)];
+    for_each_task_after(retry.size(), options.threads, after_retry, [&](size_t j) {
+      const size_t k = retry[j];
+      make(k);
+      std::lock_guard<std::mutex> g(lock);
+      if (options.progress)
+        options.progress(static_cast<int>(j + 1), static_cast<int>(retry.size()),
+                         fap_label(work[k].fap->fap, work[k].side) + " (second group)");
+    });
+    for (size_t j = 0; j < retry.size(); ++j) {
+      const size_t k = retry[j];
+      work[k].second = false;
+      FapOutcome &first = own[j].outcome, &second = results[k].outcome;
+      std::string group;
+      for (const FapContraction &c : second_group(model, *work[k].fap, work[k].side)) {
+        char b[96];
+        std::snprintf(b, sizeof b, "%s%s %+.0f %%", group.empty() ? "" : ", ", c.muscle.c_str(), c.percent);
+        group += b;
+      }
+      if (second.made && miss(second) < miss(first)) {
+        char b[96];
+        std::snprintf(b, sizeof b, "): its own reached %.0f %% of the prescribed motion", 100 * first.reached);
+        second.message = "made with its second group (" + group + b +
+                         (second.message.empty() ? "" : "; " + second.message);
+        second.seconds += first.seconds;
+      } else {
+        first.message += "; its second group (" + group + ") came no nearer";
+        first.seconds += second.seconds;
+        results[k] = std::move(own[j]);
+      }
+    }
+  }
   for (size_t k = 0; k < work.size(); ++k) {
     if (same_as[k] == k) continue;
     const Result &first = results[same_as[k]];

@@ -122,6 +122,19 @@
 // FapSynthesisOptions::hold_reach = false stores the pose once, at the
 // table's reference.
 //
+// Second groups (FapMapping::second_positive, _negative). A side whose own
+// group falls short of the reference is made again with its second group,
+// in a pass after the others (mirror twins as above), and the target whose
+// FDP lands nearer the prescribed motion (|achieved - prescribed|) is
+// kept, the other's outcome message saying so; a kept second group's
+// target is the side's only one, reaching, then held, as any. Kept whole
+// rather than as an in-between past the own group's reach: Song's upper lip
+// sides (FAPs 8, 9, 55, 56) as in-betweens at the reference, 8 to 19 FAP
+// units past the reach, were extrapolated along their short last segment,
+// and Xface's disgust.fap took 8.5 44 % off its prescribed motion (7.5 %
+// with the one target). FapSynthesisOptions::second_groups = false: the
+// own groups alone.
+//
 // Helpers (steer.h; FapMapping::helpers): where a group's pose, at the
 // value or at its cap, moves the FDP off the FAP's direction by more than
 // kSteerAbove of the prescribed motion, the row's helpers join the group at
@@ -216,6 +229,10 @@ struct FapSynthesisOptions {
   // it to the table's reference ("Reach, then hold"); false: once, at the
   // table's reference.
   bool hold_reach = true;
+  // Make a side its own group leaves short again with its second group
+  // (FapMapping::second_positive, _negative) and keep the nearer ("Second
+  // groups"); false: the own groups alone.
+  bool second_groups = true;
   // Workers (0: one per core). The targets are the same for any number.
   int threads = 0;
   // The simulation mesh the model was built on (sim_mesh.h), when it is
@@ -231,11 +248,11 @@ struct FapSynthesisOptions {
 
 // What a synthesis with `options` poses, for a model built only for it
 // (FaceModelOptions::calibrate_muscles, calibrate_only, calibrate_jaw): the
-// muscles of every listed FAP's groups, both sides and their fallbacks, and
-// of every listed viseme and expression, and of a listed right FAP's left
-// twin (made and dropped: see "Mirror twins"), with every right muscle's
-// left twin (face_model.h: it calibrates from it); the jaw for the jaw FAPs and a
-// viseme or expression that opens it. Each muscle calibrates on its own, so
+// muscles of every listed FAP's groups, both sides, their fallbacks and
+// second groups, and of every listed viseme and expression, and of a listed
+// right FAP's left twin (made and dropped: see "Mirror twins"), with every
+// right muscle's left twin (face_model.h: it calibrates from it); the jaw
+// for the jaw FAPs and a viseme or expression that opens it. Each muscle calibrates on its own, so
 // the poses are the same as on a model with every muscle calibrated (the
 // targets split shared skin only among those made: fap_partition.h).
 // Nothing listed: every muscle and the jaw (`all`).

@@ -39,6 +39,7 @@ std::vector<HelperColumn> helper_columns(const FaceModel &model, const std::vect
     const Muscle &m = model.muscles[static_cast<size_t>(i)];
     HelperColumn c;
     c.muscle = i;
+    if (m.name.rfind("lip_protrusion_", 0) == 0) c.cost = kHelperCost * kProtrusionCost;
     if (m.tension_max > 0) c.plus = motion_of(m.response_max, node, &c.largest_plus);
     if (m.tension_min > 0) c.minus = motion_of(m.response_min, node, &c.largest_minus);
     if (c.plus.squaredNorm() > 0 || c.minus.squaredNorm() > 0) out.push_back(c);
@@ -53,7 +54,7 @@ SteerModel steer_model(const std::vector<HelperColumn> &helpers, const Eigen::Ma
     for (const auto &[r, largest] : {std::pair{h.plus, h.largest_plus}, std::pair{h.minus, h.largest_minus}}) {
       const double back = std::min(r.dot(along), 0.0);
       m.column.push_back(measured * r);
-      m.cost.push_back(kHelperCost * largest * largest + back * back);
+      m.cost.push_back(h.cost * largest * largest + back * back);
     }
   return m;
 }

@@ -16,11 +16,12 @@
 // the helpers at c0, the helpers' contractions c (signed fractions of
 // their range, |c| <= kHelperBound) minimise
 //
-//     |e + sum_h M r_h (c_h - c0_h)|^2 + sum_h (kHelperCost L_h^2 + b_h^2) c_h^2,
+//     |e + sum_h M r_h (c_h - c0_h)|^2 + sum_h (k_h L_h^2 + b_h^2) c_h^2,
 //
 // r_h = r+ or r- by the sign of c_h (two variables per helper, each in
 // [0, kHelperBound]), L_h the largest motion of any node in that calibrated
-// pose (a helper that moves the FDP little and the face much costs much),
+// pose (a helper that moves the FDP little and the face much costs much;
+// k_h = kHelperCost, times kProtrusionCost for the lips' protrusion drivers),
 // b_h its motion of the FDP back against the FAP's direction (a helper may
 // not undo the group's work). Projected coordinate descent; the problem is
 // convex and small. In the solve the helpers are part of the group's
@@ -50,6 +51,17 @@ namespace afmb {
 constexpr double kHelperBound = 0.5;
 // The weight of a helper's largest motion against the FDP's off-axis motion.
 constexpr double kHelperCost = 0.05;
+// The lips' protrusion drivers (lip_protrusion_upper, _lower) pay this
+// share of it: the one helper that moves a lip in depth (fap_mapping.cpp),
+// their largest motion is the lip's own middle, beside the lip FDPs they
+// steer, so that at the full cost they stopped at a third of their range
+// while the upper lip's sides went 25-30 % of their motion off in depth
+// (the generated 10k head). At a fifth, off-axis medians of the three
+// heads' reports 11.5 / 13.4 / 12.6 % (Song, 10k, 2k) against 11.5 / 18.2 /
+// 11.7 %, and the real streams' summed distance from their prescription
+// (afm-play --fdp-motion) 1,640 / 2,128 / 2,074 against 1,682 / 2,184 /
+// 2,085 (docs/fap_mapping.md, "Second groups").
+constexpr double kProtrusionCost = 0.2;
 // A helper chosen at less than this (a fraction of its range) is left out.
 constexpr double kHelperLeast = 0.01;
 // The off-axis share (of the prescribed motion) above which a group is
@@ -67,6 +79,7 @@ struct HelperColumn {
   // of any node in them.
   Eigen::Vector3d plus = Eigen::Vector3d::Zero(), minus = Eigen::Vector3d::Zero();
   double largest_plus = 0, largest_minus = 0;
+  double cost = kHelperCost;  // the weight of its largest motion (kHelperCost, kProtrusionCost)
 };
 
 // The helpers named in `names` that the model has, that are not in `group`

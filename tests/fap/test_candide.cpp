@@ -365,3 +365,76 @@ TEST(Candide3, SongsBrowSqueezeMovesTheMiddleBrowNoFurtherThanCandidesBlock) {
 }
 
 }  // namespace
+
+namespace {
+
+// Song's upper lip side lowered and raised (FAP 8, FDP 2.6), as Candide-3's
+// FAP 8 block moves it: straight down, the whole reference. Song's upper
+// lip muscle alone, pushed, dents the lip at its insertion (8.10) and turns
+// the skin over at the outer lip with 2.6 down 45 % of the way; its second
+// group (fap_mapping.cpp: with zygomaticus minor, which inserts beside 2.6)
+// takes it all the way. Without the second groups the side under-reaches,
+// which this checks too, so that it is the second group that reaches.
+TEST(Candide3, SongsUpperLipSideComesDownItsWholeReferenceAsCandidesBlockMovesIt) {
+  AFM_REQUIRE_SHARED_DATA();
+  Candide c;
+  ASSERT_TRUE(read_candide(afmtest::shared_data("faces/candide3/candide3.wfm"), &c));
+  const CandideBlock *blk = nullptr;
+  for (const CandideBlock &k : c.faps)
+    if (k.fap == 8) blk = &k;
+  ASSERT_TRUE(blk && blk->moves.size() == 1) << "Candide-3's FAP 8 block moves one vertex";
+  const Eigen::Vector3d candide = blk->moves[0].second.normalized();
+
+  FapSynthesisOptions o;
+  o.only = {8};
+  const afmtest::SongOnSimMesh song = afmtest::song_on_sim_mesh(calibration_needs(o).muscles);
+  ASSERT_FALSE(HasFailure());
+  const SimFaceModel &sm = song.built;
+  o.sim = &sm.sim;
+  const FdpPoint *p = song.face.fdps.find(FdpId{2, 6}, sm.sim.skin);
+  ASSERT_TRUE(p && p->vertex >= 0);
+  const double value = 120 * fapu_distance(sm.model.fapu, AFM_FAPU_MNS) / 1024.0;
+  ASSERT_EQ(find_fap_mapping(8)->reference, 120);
+  // FDP 2.6's motion in each side's target at the table's reference (the
+  // side's only one, or its hold), and whether its message names the
+  // second group.
+  struct Side {
+    Eigen::Vector3d motion = Eigen::Vector3d::Zero();
+    bool found = false, second = false;
+  };
+  auto sides = [&](bool second_groups, Side got[2]) {
+    FapSynthesisOptions oo = o;
+    oo.second_groups = second_groups;
+    Expected<FapSynthesis> syn = synthesize_faps(sm.scene, sm.model, oo);
+    ASSERT_TRUE(syn.is_ok()) << syn.status().message();
+    size_t next = 0;
+    for (const FapOutcome &out : syn->outcomes) {
+      if (!out.made) continue;
+      const Eigen::MatrixXd &D = syn->targets[next++].displacement[static_cast<size_t>(sm.sim.skin)];
+      if (out.number != 8 || std::abs(out.reference) != 120) continue;
+      Side &s = got[out.side > 0 ? 0 : 1];
+      s.motion = D.row(p->vertex).transpose();
+      s.found = true;
+      s.second = out.message.find("second group (") != std::string::npos &&
+                 out.message.find("came no nearer") == std::string::npos;
+    }
+  };
+  Side with[2], without[2];
+  sides(true, with);
+  sides(false, without);
+  ASSERT_FALSE(HasFailure());
+  for (int k = 0; k < 2; ++k) {
+    const double sign = k == 0 ? 1 : -1;
+    ASSERT_TRUE(with[k].found && without[k].found) << "FAP 8's target at " << sign * 120;
+    const double along = sign * with[k].motion.dot(candide), alone = sign * without[k].motion.dot(candide);
+    std::printf("FAP 8 at %+.0f: 2.6 moves %.3f of %.3f along Candide's block (cosine %.3f); the upper lip "
+                "muscle alone %.3f\n",
+                sign * 120, along, value, sign * cosine(with[k].motion, candide), alone);
+    EXPECT_TRUE(with[k].second) << "side " << sign;
+    EXPECT_GT(along, 0.97 * value);
+    EXPECT_GT(sign * cosine(with[k].motion, candide), 0.95);
+    EXPECT_LT(alone, 0.9 * value) << "the own group reaches: the second group is not what this checks";
+  }
+}
+
+}  // namespace
