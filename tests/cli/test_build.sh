@@ -18,6 +18,8 @@ bin="$bin/afm-build"
 [ "$("$bin" --list-faps | grep -c '^ *[0-9]')" -eq 66 ] || fail "--list-faps does not list FAPs 3..68"
 [ "$("$bin" --list-faps | grep -c '^v[0-9]')" -eq 14 ] || fail "--list-faps does not list the 14 visemes"
 [ "$("$bin" --list-faps | grep -c '^e[0-9]')" -eq 6 ] || fail "--list-faps does not list the 6 expressions"
+"$bin" --list-faps | grep -q "^ 8 lower_t_lip_lm .*  second + upper_lip_left +100%, zygomaticus_minor_left -100%  second - " ||
+  fail "--list-faps lacks FAP 8's second groups"
 
 "$gen" --vertices 1000 -o "$tmp/h.wrl" >/dev/null 2>&1 || fail "afm-headgen failed"
 
