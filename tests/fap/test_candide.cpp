@@ -364,10 +364,6 @@ TEST(Candide3, SongsBrowSqueezeMovesTheMiddleBrowNoFurtherThanCandidesBlock) {
   EXPECT_EQ(checked, 1) << "FAP 37's positive target";
 }
 
-}  // namespace
-
-namespace {
-
 // Song's upper lip side lowered and raised (FAP 8, FDP 2.6), as Candide-3's
 // FAP 8 block moves it: straight down, the whole reference. Song's upper
 // lip muscle alone, pushed, dents the lip at its insertion (8.10) and turns
