@@ -15,20 +15,33 @@ namespace {
 constexpr double kNone = -std::numeric_limits<double>::infinity();
 
 // The 1D parabolic dilation of n values a stride apart, in place: out(i) =
-// max over |i - k| <= reach of in(k) - ((i - k) cell)^2 / (2 rho).
-void dilate_line(double *z, int n, int stride, double cell, double rho, int reach, std::vector<double> &tmp) {
+// max over |i - k| <= reach of in(k) - drop[|i - k|], drop[m] = (m cell)^2 /
+// (2 rho) (drop_table). The line is gathered first and the drops looked up:
+// the division per pair took 1.4 % of Song's AFM's CPU, on one worker.
+void dilate_line(double *z, int n, int stride, int reach, const std::vector<double> &drop, std::vector<double> &line,
+                 std::vector<double> &tmp) {
+  line.resize(static_cast<size_t>(n));
   tmp.assign(static_cast<size_t>(n), kNone);
-  for (int i = 0; i < n; ++i) {
-    double best = kNone;
-    for (int k = std::max(0, i - reach); k <= std::min(n - 1, i + reach); ++k) {
-      const double zk = z[static_cast<ptrdiff_t>(k) * stride];
-      if (zk == kNone) continue;
-      const double d = (i - k) * cell;
-      best = std::max(best, zk - d * d / (2 * rho));
+  for (int i = 0; i < n; ++i) line[static_cast<size_t>(i)] = z[static_cast<ptrdiff_t>(i) * stride];
+  for (int k = 0; k < n; ++k) {
+    const double zk = line[static_cast<size_t>(k)];
+    if (zk == kNone) continue;
+    for (int i = std::max(0, k - reach); i <= std::min(n - 1, k + reach); ++i) {
+      double &best = tmp[static_cast<size_t>(i)];
+      best = std::max(best, zk - drop[static_cast<size_t>(std::abs(i - k))]);
     }
-    tmp[static_cast<size_t>(i)] = best;
   }
   for (int i = 0; i < n; ++i) z[static_cast<ptrdiff_t>(i) * stride] = tmp[static_cast<size_t>(i)];
+}
+
+// drop[m] = (m cell)^2 / (2 rho), m = 0 .. reach.
+std::vector<double> drop_table(double cell, double rho, int reach) {
+  std::vector<double> drop(static_cast<size_t>(reach) + 1);
+  for (int m = 0; m <= reach; ++m) {
+    const double d = m * cell;
+    drop[static_cast<size_t>(m)] = d * d / (2 * rho);
+  }
+  return drop;
 }
 
 }  // namespace
@@ -82,10 +95,11 @@ DepthMap front_depth(const Eigen::MatrixXd &V, const Eigen::MatrixXi &F, double 
 void drape(DepthMap &map, double rho) {
   if (!(rho > 0) || map.nx == 0) return;
   const int reach = static_cast<int>(std::ceil(2 * rho / map.cell));
-  std::vector<double> tmp;
+  const std::vector<double> drop = drop_table(map.cell, rho, reach);
+  std::vector<double> line, tmp;
   for (int j = 0; j < map.ny; ++j)
-    dilate_line(map.z.data() + static_cast<ptrdiff_t>(j) * map.nx, map.nx, 1, map.cell, rho, reach, tmp);
-  for (int i = 0; i < map.nx; ++i) dilate_line(map.z.data() + i, map.ny, map.nx, map.cell, rho, reach, tmp);
+    dilate_line(map.z.data() + static_cast<ptrdiff_t>(j) * map.nx, map.nx, 1, reach, drop, line, tmp);
+  for (int i = 0; i < map.nx; ++i) dilate_line(map.z.data() + i, map.ny, map.nx, reach, drop, line, tmp);
 }
 
 TeethClearance teeth_clearance(const Scene &scene, const FaceModel &model, const SimMesh *sim) {

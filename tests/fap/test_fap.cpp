@@ -34,6 +34,7 @@
 #include "fap/jaw_lips.h"
 #include "fap/fidelity_report.h"
 #include "fap/steer.h"
+#include "fap/teeth_clearance.h"
 #include "fap/untangle.h"
 #include "io/load_face.h"
 #include "refhead/refhead.h"
@@ -1175,6 +1176,53 @@ void unit_grid(int k, Eigen::MatrixXd &V, Eigen::MatrixXi &F) {
       F.row(f++) << a, a + 1, a + k + 1;
       F.row(f++) << a, a + k + 1, a + k;
     }
+}
+
+// The teeth's draped front (fap/teeth_clearance.h), computed in two 1D
+// passes with a table of drops, against the 2D definition evaluated
+// directly: E(q) = max over covered cells p within the drape's reach (2 rho,
+// in cells, along each axis) of Z(p) - |q - p|^2 / (2 rho); cells that no
+// covered cell reaches stay uncovered.
+TEST(TeethClearance, TheDrapeIsTheParabolicDilationOfTheCoveredCells) {
+  const double none = -std::numeric_limits<double>::infinity();
+  DepthMap m;
+  m.cell = 0.125;
+  m.nx = 41, m.ny = 29;
+  m.z.assign(static_cast<size_t>(m.nx * m.ny), none);
+  uint32_t seed = 12345;
+  auto next = [&seed] { return (seed = seed * 1664525u + 1013904223u) >> 8; };
+  int covered = 0;
+  for (int j = 9; j < 20; ++j)
+    for (int i = 9; i < 24; ++i)
+      if (next() % 4 != 0) m.z[static_cast<size_t>(j * m.nx + i)] = (next() % 1000) / 250.0, ++covered;
+  ASSERT_GT(covered, 80);
+  const DepthMap z0 = m;
+  const double rho = 0.5;
+  const int reach = static_cast<int>(std::ceil(2 * rho / m.cell));  // 8 cells
+  drape(m, rho);
+  int reached = 0, left = 0;
+  for (int j = 0; j < m.ny; ++j)
+    for (int i = 0; i < m.nx; ++i) {
+      double want = none;
+      for (int l = std::max(0, j - reach); l <= std::min(m.ny - 1, j + reach); ++l)
+        for (int k = std::max(0, i - reach); k <= std::min(m.nx - 1, i + reach); ++k) {
+          const double z = z0.z[static_cast<size_t>(l * m.nx + k)];
+          if (z == none) continue;
+          const double dx = (i - k) * m.cell, dy = (j - l) * m.cell;
+          want = std::max(want, z - (dx * dx + dy * dy) / (2 * rho));
+        }
+      const double got = m.z[static_cast<size_t>(j * m.nx + i)];
+      if (want == none) {
+        EXPECT_EQ(got, none) << "cell " << i << ", " << j;
+        ++left;
+      } else {
+        EXPECT_NEAR(got, want, 1e-12) << "cell " << i << ", " << j;
+        ++reached;
+      }
+    }
+  // The map's margin stays uncovered beyond the reach: both cases are met.
+  EXPECT_GT(reached, 300);
+  EXPECT_GT(left, 100);
 }
 
 // untangle() (untangle.h) on a flat 6 x 6 grid whose middle vertex is
