@@ -17,7 +17,7 @@ constexpr double kNone = -std::numeric_limits<double>::infinity();
 // The 1D parabolic dilation of n values a stride apart, in place: out(i) =
 // max over |i - k| <= reach of in(k) - drop[|i - k|], drop[m] = (m cell)^2 /
 // (2 rho) (drop_table). The line is gathered first and the drops looked up:
-// the division per pair took 1.4 % of Song's AFM's CPU, on one worker.
+// the division per pair took 1.4 % of Song's AFM's CPU, on one thread.
 void dilate_line(double *z, int n, int stride, int reach, const std::vector<double> &drop, std::vector<double> &line,
                  std::vector<double> &tmp) {
   line.resize(static_cast<size_t>(n));
