@@ -36,7 +36,7 @@ struct Element {
   double shape;   // shape term: k_s V_nom / R^2 (R: radius of gyration at rest)
   // Collapse floor per slab: k_c x the slab's share of V_nom, 0 where it has
   // none (off, or a slab that holds no tissue: slab_holds_tissue), and the
-  // slab's signed rest volume.
+  // slab's signed rest volume where it has a floor (0 elsewhere).
   double collapse[3];
   double slab_rest[3];
 };
@@ -159,10 +159,10 @@ struct System {
         const double gyration2 = (p.rowwise() - p.colwise().mean()).squaredNorm() / 12.0;
         e.shape = gyration2 > 0 ? m.params.shape_modulus * m.nominal_volume[f] / gyration2 : 0.0;
         for (int sl = 0; sl < 3; ++sl) {
-          e.slab_rest[sl] = element_volume(m, m.X0, f, nullptr, sl);
           e.collapse[sl] = m.params.collapse_modulus > 0 && slab_holds_tissue(m, f, sl)
                                ? m.params.collapse_modulus * slab_nominal_volume(m, f, sl)
                                : 0.0;
+          e.slab_rest[sl] = e.collapse[sl] > 0 ? element_volume(m, m.X0, f, nullptr, sl) : 0.0;
         }
         elements.push_back(e);
       }
