@@ -8,6 +8,7 @@
 #include <cstdarg>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <system_error>
 
 #include "core/atomic_file.h"
@@ -234,6 +235,10 @@ Status write_fidelity_report(const std::string &dir, const Scene &scene, const F
   std::vector<std::vector<uint8_t>> tiles;
   std::vector<std::string> tile_names;
   const int total = 1 + static_cast<int>(s.targets.size());
+  // One renderer for every picture: its context and shaders are made once.
+  afm_renderer *made = nullptr;
+  if (afm_renderer_create(&made) != AFM_OK) return Status::error(dir + ": render: " + afm_render_last_error());
+  const std::unique_ptr<afm_renderer, void (*)(afm_renderer *)> renderer(made, afm_renderer_destroy);
   // A face picture (the closeup, `markers` over it), or another scene
   // (`views` and framing of `other`).
   auto picture = [&](const std::string &stem, const Scene &posed, const std::vector<SceneMarkers> &markers,
@@ -241,7 +246,7 @@ Status write_fidelity_report(const std::string &dir, const Scene &scene, const F
     SceneRenderOptions o = other ? *other : ro;
     o.markers = markers;
     const std::string path = dir + sep + "targets" + sep + stem + ".png";
-    Expected<std::vector<std::vector<uint8_t>>> img = render_scene(posed, other ? nullptr : &fdps, o);
+    Expected<std::vector<std::vector<uint8_t>>> img = render_scene(posed, other ? nullptr : &fdps, o, renderer.get());
     if (!img) return img.status().wrap(path);
     afm_render_image image{img->front().data(), o.width, o.height};
     if (afm_png_write(path.c_str(), &image) != AFM_OK)

@@ -51,7 +51,8 @@ bool in_face(const FdpId &id) { return id.group != 10 && id.group != 11 && id.gr
 }  // namespace
 
 Expected<std::vector<std::vector<uint8_t>>> render_scene(const Scene &scene, const FdpSet *fdps,
-                                                         const SceneRenderOptions &options) {
+                                                         const SceneRenderOptions &options,
+                                                         afm_renderer *renderer) {
   if (options.width <= 0 || options.height <= 0 || options.views.empty())
     return Status::error("render: need a positive image size and at least one view");
   std::vector<MeshData> data;
@@ -156,9 +157,11 @@ Expected<std::vector<std::vector<uint8_t>>> render_scene(const Scene &scene, con
     }
   }
 
-  afm_renderer *renderer = nullptr;
-  if (afm_renderer_create(&renderer) != AFM_OK)
-    return Status::error(std::string("render: ") + afm_render_last_error());
+  afm_renderer *own = nullptr;
+  if (!renderer) {
+    if (afm_renderer_create(&own) != AFM_OK) return Status::error(std::string("render: ") + afm_render_last_error());
+    renderer = own;
+  }
   std::vector<std::vector<uint8_t>> images;
   for (const SceneView &v : options.views) {
     view.yaw_deg = v.yaw_deg;
@@ -166,12 +169,12 @@ Expected<std::vector<std::vector<uint8_t>>> render_scene(const Scene &scene, con
     std::vector<uint8_t> rgba((size_t)options.width * options.height * 4);
     if (afm_renderer_draw(renderer, meshes.data(), meshes.size(), &view, rgba.data()) != AFM_OK) {
       std::string msg = afm_render_last_error();
-      afm_renderer_destroy(renderer);
+      afm_renderer_destroy(own);
       return Status::error("render: " + msg);
     }
     images.push_back(std::move(rgba));
   }
-  afm_renderer_destroy(renderer);
+  afm_renderer_destroy(own);
   return images;
 }
 

@@ -38,6 +38,7 @@
 #include "fap/untangle.h"
 #include "io/load_face.h"
 #include "refhead/refhead.h"
+#include "render/scene_render.h"
 #include "../common/reference_model.h"
 #include "../common/song_model.h"
 #include "../common/surface_rays.h"
@@ -1176,6 +1177,55 @@ void unit_grid(int k, Eigen::MatrixXd &V, Eigen::MatrixXi &F) {
       F.row(f++) << a, a + 1, a + k + 1;
       F.row(f++) << a, a + k + 1, a + k;
     }
+}
+
+// The fidelity report draws its pictures with one renderer
+// (render/scene_render.h): a picture drawn with a renderer that has drawn
+// others before (another size, the wireframe, markers, the skin moved) is
+// byte for byte the one a fresh renderer draws.
+TEST(FidelityReport, AReusedRendererDrawsAsAFreshOne) {
+  RefHeadOptions ho;
+  ho.skin_vertices = 1000;
+  Expected<RefHead> head = make_reference_head(ho);
+  ASSERT_TRUE(head.is_ok()) << head.status().message();
+  SceneRenderOptions a;
+  a.width = 120, a.height = 144;
+  a.views = {SceneView{}};
+  a.face_closeup = true;
+  a.fdp_dot_pixels = 0;
+  SceneRenderOptions b = a;
+  b.width = 90, b.height = 100;
+  b.views = {SceneView{30, 10}};
+  b.wireframe = true;
+  b.fdp_dot_pixels = 5;
+  SceneMarkers dots;
+  dots.points = head->scene.parts[0].V.topRows(std::min<Eigen::Index>(40, head->scene.parts[0].V.rows()));
+  dots.color = {1, 0, 0};
+  dots.size_pixels = 4;
+  b.markers = {dots};
+  Scene moved = head->scene;
+  for (Part &p : moved.parts) p.V.col(1).array() += 0.05 * p.V.col(0).array();
+
+  Expected<std::vector<std::vector<uint8_t>>> fresh = render_scene(head->scene, &head->fdps, a);
+  ASSERT_TRUE(fresh.is_ok()) << fresh.status().message();
+  afm_renderer *made = nullptr;
+  ASSERT_EQ(afm_renderer_create(&made), AFM_OK) << afm_render_last_error();
+  const std::unique_ptr<afm_renderer, void (*)(afm_renderer *)> renderer(made, afm_renderer_destroy);
+  Expected<std::vector<std::vector<uint8_t>>> other = render_scene(moved, &head->fdps, b, renderer.get());
+  ASSERT_TRUE(other.is_ok()) << other.status().message();
+  Expected<std::vector<std::vector<uint8_t>>> again = render_scene(head->scene, &head->fdps, a, renderer.get());
+  ASSERT_TRUE(again.is_ok()) << again.status().message();
+  ASSERT_EQ(fresh->size(), 1u);
+  ASSERT_EQ(again->size(), 1u);
+  EXPECT_TRUE(fresh->front() == again->front()) << "the reused renderer's picture differs from a fresh one's";
+  // Not a blank picture: the face covers part of it, the background the rest.
+  const std::vector<uint8_t> &img = fresh->front();
+  size_t background = 0;
+  for (size_t i = 0; i < img.size(); i += 4)
+    background += img[i] == img[0] && img[i + 1] == img[1] && img[i + 2] == img[2];
+  const size_t pixels = img.size() / 4;
+  EXPECT_GT(background, pixels / 10);
+  EXPECT_LT(background, pixels * 9 / 10);
 }
 
 // The teeth's draped front (fap/teeth_clearance.h), computed in two 1D
