@@ -203,12 +203,15 @@ bool BlockLdlt::analyze(const SpMat &pattern, int group, bool upper_only) {
   return true;
 }
 
-BlockLdlt::Result BlockLdlt::factorize(const SpMat &K) {
-  return b_ == 9 ? factorize_blocks<9>(K) : factorize_blocks<3>(K);
+BlockLdlt::Result BlockLdlt::factorize(const SpMat &K, bool stop_if_indefinite) {
+  complete_ = false;
+  const Result res = b_ == 9 ? factorize_blocks<9>(K, stop_if_indefinite) : factorize_blocks<3>(K, stop_if_indefinite);
+  complete_ = res == Result::kDefinite || (res == Result::kIndefinite && !stop_if_indefinite);
+  return res;
 }
 
 template <int B>
-BlockLdlt::Result BlockLdlt::factorize_blocks(const SpMat &K) {
+BlockLdlt::Result BlockLdlt::factorize_blocks(const SpMat &K, bool stop_if_indefinite) {
   constexpr int BB = B * B, P = float_rows(B);
   const int *outer = K.outerIndexPtr();
   const double *val = K.valuePtr();
@@ -264,6 +267,8 @@ BlockLdlt::Result BlockLdlt::factorize_blocks(const SpMat &K) {
     const Eigen::Matrix<double, B, 1> d = pivots.vectorD();
     if (!d.allFinite() || !(d.array().abs() > 0).all()) return Result::kSingular;
     definite = definite && (d.array() > 0).all();
+    // The caller throws an indefinite factorisation away: skip its rest.
+    if (!definite && stop_if_indefinite) return Result::kIndefinite;
     MapB<B> dinv(&d_inverse_[static_cast<size_t>(k) * BB]);
     dinv = dk.inverse();
     if (!dinv.allFinite()) return Result::kSingular;

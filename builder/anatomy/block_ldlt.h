@@ -65,12 +65,23 @@ class BlockLdlt {
   // anything, zeros included). Only the blocks on and above the diagonal (in
   // the analysed order, or with upper_only their mirrors above K's own
   // diagonal) are read, so K must be symmetric in them.
-  Result factorize(const SpMat &K);
+  // `stop_if_indefinite`: returns kIndefinite at the first pivot block that
+  // is not positive definite, the factors left incomplete, for a caller
+  // that only uses a definite factorisation (the solver's full tangent: an
+  // indefinite one is thrown away; on Song's AFM that stop skips a fifth of
+  // the factorisations' block updates). Without it, or where K is definite,
+  // it runs to the end.
+  Result factorize(const SpMat &K, bool stop_if_indefinite = false);
 
-  // x = K^-1 b (n each). Only after a factorize() that was not kSingular.
+  // Whether the last factorize() ran to the end and was not kSingular:
+  // solve() and precondition() may be called only then.
+  bool complete() const { return complete_; }
+
+  // x = K^-1 b (n each). Only when complete().
   void solve(const Eigen::VectorXd &b, Eigen::VectorXd &x) const;
 
-  // x ~ K^-1 b in single precision, for preconditioning: float copies of
+  // x ~ K^-1 b in single precision, for preconditioning (only when
+  // complete()): float copies of
   // the factors, made by factorize(), L by rows for the forward pass and by
   // columns for the backward one, so that both sum in registers (gathers);
   // 3 x 3 blocks padded to 4 x 3, a block times a vector being three 4-wide
@@ -96,11 +107,12 @@ class BlockLdlt {
     int offset;  // of its first entry within each of those columns
     bool transpose;  // held as its mirror across K's diagonal (analyze's upper_only)
   };
-  template <int B> Result factorize_blocks(const SpMat &K);
+  template <int B> Result factorize_blocks(const SpMat &K, bool stop_if_indefinite);
   template <int B> void solve_blocks(const Eigen::VectorXd &b, Eigen::VectorXd &x) const;
   template <int B> void precondition_blocks(const Eigen::VectorXd &b, Eigen::VectorXd &x) const;
 
   int b_ = 3;       // scalars per pivot block, 3 x the nodes in it
+  bool complete_ = false;  // complete()
   int blocks_ = 0;  // pivot groups
   std::vector<int> order_;     // order_[new] = old group
   std::vector<int> position_;  // position_[old] = new group

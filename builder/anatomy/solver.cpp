@@ -1048,8 +1048,8 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
         copy_values(K, Kf);
         contacts.filter(sys, Kf);
         ++st.factorisations;
-        const Ldlt::Result res = entry->symbolic.factorize(Kf);
-        entry->factored = res != Ldlt::Result::kSingular;
+        const Ldlt::Result res = entry->symbolic.factorize(Kf, true);
+        entry->factored = entry->symbolic.complete();
         if (res == Ldlt::Result::kDefinite) {
           shift = mu;
           full = false;
@@ -1063,10 +1063,12 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
       for (;;) {
         copy_values(K, Kf);
         contacts.filter(sys, Kf);
-        const Ldlt::Result res = entry->symbolic.factorize(Kf);
+        // The full tangent's factorisation is kept only where definite: it
+        // stops at the first indefinite pivot.
+        const Ldlt::Result res = entry->symbolic.factorize(Kf, full);
         ++st.factorisations;
         const bool ok = res != Ldlt::Result::kSingular;
-        entry->factored = ok;
+        entry->factored = entry->symbolic.complete();
         if (ok && (!full || res == Ldlt::Result::kDefinite)) break;
         if (!full) return false;
         if (projected_run >= 2 && shifted()) break;

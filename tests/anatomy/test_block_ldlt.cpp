@@ -5,6 +5,7 @@
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -234,6 +235,51 @@ TEST(BlockLdlt, SaysWhenTheMatrixIsIndefiniteAndStillSolvesIt) {
   f.solve(b, x);
   const Eigen::VectorXd ref = Eigen::MatrixXd(K).partialPivLu().solve(b);
   EXPECT_LT((x - ref).norm(), 1e-8 * ref.norm());
+}
+
+// The solver's full tangent is kept only where definite, so its
+// factorisation may stop at the first pivot that is not (factorize's
+// stop_if_indefinite). A definite matrix is factorised whole, the same to
+// the bit; an indefinite one stops incomplete, and the next factorisation
+// starts clean. A pivot block of NaN shows where it stopped: on a negative
+// definite matrix the first pivot already stops it, so a NaN at one of two
+// nodes (at most one of them pivots first) goes unread, which a
+// factorisation to the end reports as singular.
+TEST(BlockLdlt, StopsAtTheFirstIndefinitePivotWhenAsked) {
+  const SpMat K = grid_matrix(5, 4, 3, 1.05, 21);
+  const Eigen::VectorXd b = random_vector(K.rows(), 22);
+  BlockLdlt f;
+  ASSERT_TRUE(f.analyze(K));
+  Eigen::VectorXd whole, stopping;
+  ASSERT_EQ(f.factorize(K), BlockLdlt::Result::kDefinite);
+  EXPECT_TRUE(f.complete());
+  f.solve(b, whole);
+  ASSERT_EQ(f.factorize(K, true), BlockLdlt::Result::kDefinite);
+  EXPECT_TRUE(f.complete());
+  f.solve(b, stopping);
+  EXPECT_EQ(whole, stopping) << "a definite matrix is factorised whole either way";
+
+  const SpMat negative = -K;
+  int unread = 0;
+  for (int node : {0, 1}) {
+    SpMat poisoned = negative;
+    for (int k = 3 * node; k < 3 * node + 3; ++k)
+      for (SpMat::InnerIterator it(poisoned, k); it; ++it)
+        if (it.row() / 3 == node) it.valueRef() = std::numeric_limits<double>::quiet_NaN();
+    EXPECT_EQ(f.factorize(poisoned), BlockLdlt::Result::kSingular) << "node " << node;
+    EXPECT_FALSE(f.complete());
+    const BlockLdlt::Result r = f.factorize(poisoned, true);
+    EXPECT_FALSE(f.complete());
+    unread += r == BlockLdlt::Result::kIndefinite;
+  }
+  EXPECT_GE(unread, 1) << "the factorisation went on past an indefinite pivot";
+  EXPECT_EQ(f.factorize(negative, true), BlockLdlt::Result::kIndefinite);
+  EXPECT_FALSE(f.complete());
+  // After a stop, a whole factorisation solves as one from scratch.
+  ASSERT_EQ(f.factorize(K), BlockLdlt::Result::kDefinite);
+  EXPECT_TRUE(f.complete());
+  f.solve(b, stopping);
+  EXPECT_EQ(whole, stopping);
 }
 
 TEST(BlockLdlt, RefusesASingularMatrix) {
