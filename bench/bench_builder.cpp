@@ -4,8 +4,8 @@
 // there also with each muscle group alone (no helpers, fap/steer.h), time
 // to equilibrium per muscle, dynamic sets against whole-mesh solves,
 // iterations when the epidermis is 10 times stiffer (one muscle, then every
-// muscle, with every solver), and the paper's solver beside the others, all
-// in one run.
+// muscle, with every solver, and the default without its half tangent), and
+// the paper's solver beside the others, all in one run.
 //
 // Usage: bench_builder [SKIN_VERTICES] (default 10000). The Song head runs
 // too when ../shared/data is present. Figures are wall times of one run on a
@@ -227,6 +227,7 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
   }
   // One muscle's set at its calibrated +100 % tension, from rest, on the
   // default tissue (0) and on `other`'s (1); the poses into X when given.
+  bool half_tangent = true;  // SolverOptions::half_tangent
   auto solve_pair = [&](const FaceModel &other, const Muscle &mu, SolverKind kind, SolveStats st[2],
                         Eigen::MatrixXd *X = nullptr) {
     for (int s = 0; s < 2; ++s) {
@@ -237,6 +238,7 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
       Eigen::MatrixXd pose = fm.tissue.X0;
       SolverOptions so = m->solver;
       so.kind = kind;
+      so.half_tangent = half_tangent;
       FactorCache cache;
       st[s] = solve_equilibrium(fm.tissue, mu.dynamic, f, fm.tissue.X0, pose, so, &cache);
       if (X) X[s] = std::move(pose);
@@ -288,6 +290,20 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
               "CG per step %+.0f %%\n",
               solver_name(m->solver.kind), its[0], its[1], change(its[0], its[1]), least, most,
               change(per_step(cgs[0], its[0]), per_step(cgs[1], its[1])));
+  // The same without the half tangent (solver.h): the projected one
+  // directly where the full one is indefinite.
+  {
+    half_tangent = false;
+    int n[2] = {0, 0}, failed[2] = {0, 0};
+    for (const Muscle &mu : m->muscles) {
+      SolveStats st[2];
+      solve_both(mu, m->solver.kind, st);
+      for (int s = 0; s < 2; ++s) n[s] += st[s].iterations, failed[s] += !st[s].converged;
+    }
+    half_tangent = true;
+    std::printf("%s without the half tangent: iterations %d, x10 %d (%+.0f %%), %d and %d failed\n",
+                solver_name(m->solver.kind), n[0], n[1], change(n[0], n[1]), failed[0], failed[1]);
+  }
 
   // The collapse floor (skin_model.h, TissueParams::collapse_modulus): every
   // muscle at its calibrated +100 % tension on its set, without and with it.

@@ -327,14 +327,15 @@ void add_tie(double *values, const std::array<Block, 4> &bl, const Eigen::Matrix
 // and/or the Hessian into *K (the system's pattern) and *diag (its
 // diagonal), in one pass over the springs and elements: a Newton step needs
 // both at the same X. Either pair may be null. The Hessian: springs, the
-// shape term and the volume term. Not `full` (the projected tangent): the
-// indefinite parts are dropped (a compressed spring's negative transverse
-// stiffness, the volume's own curvature k_v (V - V0) / |V0| d2V/dp2, leaving
-// its Gauss-Newton part), which keeps K positive semi-definite everywhere;
-// `full`, Newton converges quadratically near an equilibrium, where K is
-// definite anyway.
+// shape term and the volume term. `curvature`, 0..1: the share of its
+// indefinite parts kept (a compressed spring's negative transverse
+// stiffness, the volume's own curvature k_v (V - V0) / |V0| d2V/dp2 beside
+// its Gauss-Newton part). 1 is the full tangent, with which Newton
+// converges quadratically near an equilibrium, where K is definite anyway;
+// 0 the projected one, positive semi-definite everywhere; the solver tries
+// a half in between (solve_equilibrium).
 void assemble(const System &sys, const Eigen::MatrixXd &X, const Eigen::MatrixXd *ref, Vec *r, SpMat *K, Vec *diag,
-              bool full) {
+              double curvature) {
   const SkinModel &m = sys.m;
   if (r) r->setZero(sys.dofs());
   double *val = nullptr;
@@ -357,7 +358,7 @@ void assemble(const System &sys, const Eigen::MatrixXd &X, const Eigen::MatrixXd
     }
     if (K) {
       const Eigen::Vector3d u = d / l;
-      const double geo = (t >= 0 || full ? t : 0.0) / l;
+      const double geo = (t >= 0 ? t : curvature * t) / l;
       const Eigen::Matrix3d B = (dt - geo) * u * u.transpose() + geo * Eigen::Matrix3d::Identity();
       add_tie(val, sys.tie_blocks[q], B);
     }
@@ -390,7 +391,7 @@ void assemble(const System &sys, const Eigen::MatrixXd &X, const Eigen::MatrixXd
     if (el.weight > 0) {
       const double v = element_volume(m, X, el.f, &g);
       if (r) push(el, -el.weight * (v - m.rest_volume[el.f]), g);
-      if (K && full) excess = el.weight * (v - m.rest_volume[el.f]);
+      if (K && curvature > 0) excess = curvature * el.weight * (v - m.rest_volume[el.f]);
       if (excess != 0) element_volume_hessian(m, X, el.f, &H);
     }
     // Squeezed slabs: the floor's force, and its Gauss-Newton part
@@ -449,8 +450,8 @@ void assemble(const System &sys, const Eigen::MatrixXd &X, const Eigen::MatrixXd
 }
 
 // The Hessian alone (assemble()).
-void linearise(const System &sys, const Eigen::MatrixXd &X, SpMat &K, Vec &diag, bool full = false) {
-  assemble(sys, X, nullptr, nullptr, &K, &diag, full);
+void linearise(const System &sys, const Eigen::MatrixXd &X, SpMat &K, Vec &diag, double curvature = 0) {
+  assemble(sys, X, nullptr, nullptr, &K, &diag, curvature);
 }
 
 // Adds the load's Hessian (ForceField) at X to K and diag.
@@ -481,8 +482,8 @@ void scatter_rows(const System &sys, const Vec &x, Eigen::MatrixXd &P) {
 // Internal plus external force on the free nodes; with K and diag, the
 // internal Hessian too (assemble()) and the load's.
 void net_force(const System &sys, const ForceField &forces, const Eigen::MatrixXd &ref,
-               const Eigen::MatrixXd &X, Vec &r, SpMat *K = nullptr, Vec *diag = nullptr, bool full = false) {
-  assemble(sys, X, &ref, &r, K, diag, full);
+               const Eigen::MatrixXd &X, Vec &r, SpMat *K = nullptr, Vec *diag = nullptr, double curvature = 0) {
+  assemble(sys, X, &ref, &r, K, diag, curvature);
   if (forces) {
     Eigen::MatrixXd F = Eigen::MatrixXd::Zero(X.rows(), 3);
     forces(X, &F, nullptr);
@@ -922,6 +923,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
   //                  than kRefreshRest iterations; then as newton;
   //   newton-jacobi  CG with the Jacobi preconditioner.
   constexpr int kRefresh = 3, kRefreshRest = 30;
+  constexpr double kHalfCurvature = 0.5;  // the half tangent's share of the indefinite parts
   const Ldlt *rest = nullptr;
   if (options.kind == SolverKind::NewtonRest) {
     rest = rest_factor(*entry);
@@ -980,11 +982,12 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
   int best_at = 0;
   int projected_run = 0;  // refreshes in a row that did not factorise the full tangent
   double shift = 1e-3;    // the last diagonal shift that made the full tangent definite
+  bool half_failed = false;  // the half tangent was indefinite in this solve
   bool energy_known = false;  // known_energy is the total energy at X (see the line search)
   double known_energy = 0;
   for (int it = 0;; ++it) {
     const ForceField load = load_at(t);
-    net_force(sys, load, reference, X, r, &K, &diag, true);
+    net_force(sys, load, reference, X, r, &K, &diag, 1.0);
     if (!finite(r)) return done(false, name + ": non-finite force");
     Vec rf = r;
     contacts.filter(rf);
@@ -1032,9 +1035,23 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     // that keeps the curvature of the compressed springs and of the volume
     // term. The 10k head's model: 451 -> 341 Newton iterations; Song's AFM
     // 1,424 -> 1,362; the same models and reports.
-    bool full = true;
+    // Before the projected tangent, the one with half the indefinite parts
+    // (kHalfCurvature, assemble()), kept where it is definite: it softens
+    // the modes that a compressed stiff skin buckles along less than the
+    // projected one, and Newton crawls less. Where it was not definite once,
+    // the solve goes to the projected tangent directly after: most of the
+    // half tangents of Song's AFM that the full one's failure led to were
+    // indefinite too (52 of 69), each a factorisation thrown away. A 10
+    // times stiffer epidermis then costs 28 % more Newton iterations over
+    // every muscle on Song (36 % without) and 29 % on the 10k head (33 %);
+    // docs/anatomy.md, "Solver".
+    enum class Tangent { Full, Half, Shifted, Projected } tangent = Tangent::Full;
+    bool full = true;  // tangent == Tangent::Full
     auto project = [&] {
-      linearise(sys, X, K, diag, full = false);
+      if (tangent == Tangent::Half) half_failed = true;
+      tangent = tangent == Tangent::Full && options.half_tangent && !half_failed ? Tangent::Half : Tangent::Projected;
+      full = false;
+      linearise(sys, X, K, diag, tangent == Tangent::Half ? kHalfCurvature : 0.0);
       add_load_stiffness(sys, load, X, K, diag);
     };
     auto shifted = [&] {
@@ -1052,6 +1069,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
         entry->factored = entry->symbolic.complete();
         if (res == Ldlt::Result::kDefinite) {
           shift = mu;
+          tangent = Tangent::Shifted;
           full = false;
           return true;
         }
@@ -1063,15 +1081,16 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
       for (;;) {
         copy_values(K, Kf);
         contacts.filter(sys, Kf);
-        // The full tangent's factorisation is kept only where definite: it
-        // stops at the first indefinite pivot.
-        const Ldlt::Result res = entry->symbolic.factorize(Kf, full);
+        // The full and the half tangent's factorisations are kept only where
+        // definite: they stop at the first indefinite pivot.
+        const bool definite_only = tangent == Tangent::Full || tangent == Tangent::Half;
+        const Ldlt::Result res = entry->symbolic.factorize(Kf, definite_only);
         ++st.factorisations;
         const bool ok = res != Ldlt::Result::kSingular;
         entry->factored = entry->symbolic.complete();
-        if (ok && (!full || res == Ldlt::Result::kDefinite)) break;
-        if (!full) return false;
-        if (projected_run >= 2 && shifted()) break;
+        if (ok && (!definite_only || res == Ldlt::Result::kDefinite)) break;
+        if (tangent == Tangent::Projected) return false;
+        if (full && projected_run >= 2 && shifted()) break;
         project();
       }
       factor = &entry->symbolic;
@@ -1110,7 +1129,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
         fresh = true;
         continue;
       }
-      if (!indefinite || !full) break;
+      if (!indefinite || (tangent != Tangent::Full && tangent != Tangent::Half)) break;
       project();  // CG met a direction of negative curvature
     }
     if (control) {
@@ -1149,6 +1168,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
       dx = u;
     }
     st.cg_iterations += cg;
+    st.half_steps += tangent == Tangent::Half;
     if (options.kind != SolverKind::NewtonJacobi &&
         cg > (options.kind == SolverKind::NewtonRest ? kRefreshRest : std::max(kRefresh, entry->refresh_after)))
       refresh = true;
@@ -1185,7 +1205,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
       if ((std::isfinite(e_trial) && e_trial <= e0 - 1e-4 * alpha * std::max(slope, 0.0)) || ls == 11) break;
       alpha *= 0.5;
     }
-    // A whole step on the projected (or shifted) tangent may fall short: that
+    // A whole step on the half, projected or shifted tangent may fall short: that
     // tangent is stiffer than the skin along a mode the compressed springs
     // soften, and Newton then crawls along it a step of the same length at a
     // time (the 10k head's zygomaticus major: 32 iterations). Twice, four and

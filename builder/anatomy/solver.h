@@ -72,10 +72,17 @@
 //                   ordering is computed once per dynamic set (FactorCache),
 //                   and a solve on a set starts with the factorisation the
 //                   last solve there ended on.
+//                   The tangent: the Hessian where it is definite; where
+//                   not, the one with half its indefinite parts (compressed
+//                   springs' negative transverse stiffness, the volume's
+//                   own curvature) where that is definite
+//                   (SolverOptions::half_tangent), else the projected one
+//                   without them, or after two projected ones in a row the
+//                   Hessian with its diagonal raised (Levenberg-Marquardt).
 //                   A backtracking (Armijo) line search on the total energy;
-//                   a whole step made on the projected or shifted tangent,
-//                   which is stiffer than the skin along the modes that
-//                   compressed springs soften, is also tried at 2, 4 and 8
+//                   a whole step made on the half, projected or shifted
+//                   tangent, which is stiffer than the skin along the modes
+//                   that compressed springs soften, is also tried at 2, 4 and 8
 //                   times its length while the energy keeps falling
 //                   (SolverOptions::extend_steps).
 //                   The default: the fastest at the whole AFM in
@@ -157,10 +164,14 @@ struct SolverOptions {
   // system's own time t0 = sqrt(mean mass / mean stiffness diagonal).
   double time_step = 20.0;
   double damping = 0.5;
-  // newton solvers: a whole step made on the projected or shifted tangent
+  // newton solvers: a whole step made on the half, projected or shifted tangent
   // that the line search accepts is tried again at 2, 4 and 8 times its
   // length while the total energy keeps falling (see "newton" above).
   bool extend_steps = true;
+  // newton solvers: where the full tangent is indefinite, the one with half
+  // its indefinite parts first, kept where it is definite, before the
+  // projected one (see "newton" above). Off: the projected one directly.
+  bool half_tangent = true;
   // Hold the lips apart (SkinModel::lip_pairs, lip_contact.h; "lips" above).
   // Off for the FAP targets and the muscles' calibration: MPEG-4 moves each
   // lip by its own FAPs, and a FAP that presses one lip onto the other moves
@@ -175,6 +186,7 @@ struct SolveStats {
   int iterations = 0;     // Newton iterations or time steps
   int cg_iterations = 0;  // summed over every linear solve
   int factorisations = 0; // numeric factorisations of the tangent (newton)
+  int half_steps = 0;     // Newton steps made on the half tangent (SolverOptions::half_tangent)
   int unknowns = 0;       // 3 x free nodes
   int contacts = 0;       // nodes held on the skull at the end
   double residual = 0;    // the Jacobi displacement estimate at the end, model units
