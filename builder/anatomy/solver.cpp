@@ -1043,8 +1043,8 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     // half tangents of Song's AFM that the full one's failure led to were
     // indefinite too (52 of 69), each a factorisation thrown away. A 10
     // times stiffer epidermis then costs 28 % more Newton iterations over
-    // every muscle on Song (36 % without) and 29 % on the 10k head (33 %);
-    // docs/anatomy.md, "Solver".
+    // every muscle on Song (36 % before) and 29 % on the 10k head (33 %);
+    // docs/anatomy.md, "Solver and stopping rule".
     enum class Tangent { Full, Half, Shifted, Projected } tangent = Tangent::Full;
     bool full = true;  // tangent == Tangent::Full
     auto project = [&] {
