@@ -30,6 +30,7 @@ namespace {
 // Dynamic set against whole mesh: a linear muscle of the mouth, a small one
 // of the brow, the mouth's sphincter.
 const char *kCompared[] = {"zygomaticus_major_left", "corrugator_left", "orbicularis_oris"};
+constexpr int kComparedRuns = 3;
 
 // The collapse floor's modulus the bench weighs (afm-build --collapse-floor).
 constexpr double kBenchFloor = 0.3;
@@ -191,22 +192,34 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
               "all muscles", "", sum, "", "", "", turned, turning, m->muscles.size(),
               static_cast<long long>(3 * m->tissue.F.rows()));
 
-  std::printf("%-24s %6s %8s %9s %9s %8s\n", "dynamic vs whole", "V_d", "dyn s", "whole s", "speed-up", "max diff");
+  // The fastest of three alternating runs of each: one run's time moved by
+  // half on this shared machine (Song's orbicularis oris on its set 0.130 s
+  // in the table above and 0.197 s here in one run), and the result is the
+  // same every time.
+  std::printf("%-24s %6s %8s %9s %9s %8s  (fastest of %d runs each)\n", "dynamic vs whole", "V_d", "dyn s", "whole s",
+              "speed-up", "max diff", kComparedRuns);
   for (const char *name : kCompared) {
     Activation a;
     a.muscles = {{m->find(name), 100.0}};
-    FactorCache cache, cache2;  // fresh: each time includes its factorisations
-    Expected<Pose> dyn = solve_pose(*m, a, &cache);
     PoseOptions whole;
     whole.whole_mesh = true;
-    Expected<Pose> all = solve_pose(*m, a, &cache2, whole);
+    Expected<Pose> dyn = Status::error("not run"), all = Status::error("not run");
+    double dyn_s = 1e300, all_s = 1e300;
+    for (int run = 0; run < kComparedRuns; ++run) {
+      FactorCache cache, cache2;  // fresh: each time includes its factorisations
+      dyn = solve_pose(*m, a, &cache);
+      all = solve_pose(*m, a, &cache2, whole);
+      if (!dyn || !all) break;
+      dyn_s = std::min(dyn_s, dyn->stats.seconds);
+      all_s = std::min(all_s, all->stats.seconds);
+    }
     if (!dyn || !all) {
       std::printf("%-24s failed: %s\n", name, (!dyn ? dyn : all).status().message().c_str());
       continue;
     }
     const double diff = (pose_epidermis(*m, *dyn) - pose_epidermis(*m, *all)).cwiseAbs().maxCoeff();
-    std::printf("%-24s %6zu %8.3f %9.3f %8.1fx %7.2fq\n", name, dyn->dynamic.size(), dyn->stats.seconds,
-                all->stats.seconds, all->stats.seconds / dyn->stats.seconds, diff / m->quantum);
+    std::printf("%-24s %6zu %8.3f %9.3f %8.1fx %7.2fq\n", name, dyn->dynamic.size(), dyn_s, all_s, all_s / dyn_s,
+                diff / m->quantum);
   }
 
   // Every solver on one muscle's set at its calibrated +100 % tension, at
