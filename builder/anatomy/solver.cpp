@@ -1046,11 +1046,9 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     // every muscle on Song (36 % before) and 29 % on the 10k head (33 %);
     // docs/anatomy.md, "Solver and stopping rule".
     enum class Tangent { Full, Half, Shifted, Projected } tangent = Tangent::Full;
-    bool full = true;  // tangent == Tangent::Full
     auto project = [&] {
       if (tangent == Tangent::Half) half_failed = true;
       tangent = tangent == Tangent::Full && options.half_tangent && !half_failed ? Tangent::Half : Tangent::Projected;
-      full = false;
       linearise(sys, X, K, diag, tangent == Tangent::Half ? kHalfCurvature : 0.0);
       add_load_stiffness(sys, load, X, K, diag);
     };
@@ -1070,7 +1068,6 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
         if (res == Ldlt::Result::kDefinite) {
           shift = mu;
           tangent = Tangent::Shifted;
-          full = false;
           return true;
         }
       }
@@ -1090,7 +1087,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
         entry->factored = entry->symbolic.complete();
         if (ok && (!definite_only || res == Ldlt::Result::kDefinite)) break;
         if (tangent == Tangent::Projected) return false;
-        if (full && projected_run >= 2 && shifted()) break;
+        if (tangent == Tangent::Full && projected_run >= 2 && shifted()) break;
         project();
       }
       factor = &entry->symbolic;
@@ -1106,7 +1103,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     };
     bool fresh = refresh;
     if (refresh && !factorise()) return done(false, name + ": the tangent stiffness is singular");
-    if (refresh) projected_run = full ? 0 : projected_run + 1;
+    if (refresh) projected_run = tangent == Tangent::Full ? 0 : projected_run + 1;
     refresh = false;
     // newton: CG past a factorisation's worth of iterations (a stale
     // factorisation, say a projected one before a full tangent) stops, and
@@ -1211,7 +1208,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     // time (the 10k head's zygomaticus major: 32 iterations). Twice, four and
     // eight times the step are tried while the energy keeps falling.
     double e_taken = e_trial;
-    if (options.extend_steps && !full && alpha == 1) {
+    if (options.extend_steps && tangent != Tangent::Full && alpha == 1) {
       for (double longer : {2.0, 4.0, 8.0}) {
         const Vec further = x0 + longer * dx;
         scatter_rows(sys, further, Xt);
