@@ -66,6 +66,8 @@ struct System {
   std::vector<int> nodes;  // free nodes, global
   std::vector<int> local;  // global node -> local index, or -1
   std::vector<int> springs;
+  std::vector<double> spring_k;                  // per spring: SkinModel::stiffness
+  std::vector<std::array<int, 2>> spring_local;  // per spring: its ends' local nodes, or -1
   std::vector<int> lips;  // SkinModel::lip_pairs with a free node, when in contact
   std::vector<Element> elements;
   std::vector<uint8_t> rejects;  // per local node: held above its skull plane
@@ -125,6 +127,11 @@ struct System {
           if (m.stiffness(m.springs[static_cast<size_t>(s)]) > 0) springs.push_back(s);
         }
     std::sort(springs.begin(), springs.end());
+    for (int si : springs) {
+      const Spring &s = m.springs[static_cast<size_t>(si)];
+      spring_k.push_back(m.stiffness(s));
+      spring_local.push_back({local[static_cast<size_t>(s.a)], local[static_cast<size_t>(s.b)]});
+    }
     for (size_t p = 0; contact && p < m.lip_pairs.size(); ++p) {
       const LipPair &lp = m.lip_pairs[p];
       if (local[static_cast<size_t>(lp.upper)] >= 0 || local[static_cast<size_t>(lp.lower)] >= 0)
@@ -349,10 +356,10 @@ void assemble(const System &sys, const Eigen::MatrixXd &X, const Eigen::MatrixXd
     const Eigen::Vector3d d = X.row(s.b) - X.row(s.a);
     const double l = std::max(d.norm(), 1e-12 * s.rest);
     double t, dt;
-    tension(s, m.stiffness(s), l, &t, &dt);
+    tension(s, sys.spring_k[q], l, &t, &dt);
     if (r) {
       const Eigen::Vector3d f = t * d / l;  // pulls a toward b when stretched
-      const int la = sys.local[static_cast<size_t>(s.a)], lb = sys.local[static_cast<size_t>(s.b)];
+      const auto [la, lb] = sys.spring_local[q];
       if (la >= 0) r->segment<3>(3 * la) += f;
       if (lb >= 0) r->segment<3>(3 * lb) -= f;
     }
@@ -497,9 +504,9 @@ double total_energy(const System &sys, const ForceField &forces, const Eigen::Ma
                     const Eigen::MatrixXd &X) {
   const SkinModel &m = sys.m;
   double e = 0;
-  for (int si : sys.springs) {
-    const Spring &s = m.springs[static_cast<size_t>(si)];
-    e += spring_energy(s, m.stiffness(s), (X.row(s.b) - X.row(s.a)).norm());
+  for (size_t q = 0; q < sys.springs.size(); ++q) {
+    const Spring &s = m.springs[static_cast<size_t>(sys.springs[q])];
+    e += spring_energy(s, sys.spring_k[q], (X.row(s.b) - X.row(s.a)).norm());
   }
   for (size_t i = 0; i < sys.lips.size(); ++i) {
     const LipPair &p = m.lip_pairs[static_cast<size_t>(sys.lips[i])];
@@ -985,6 +992,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
   bool half_failed = false;  // the half tangent was indefinite in this solve
   bool energy_known = false;  // known_energy is the total energy at X (see the line search)
   double known_energy = 0;
+  Eigen::MatrixXd Xt;  // the line search's trial positions
   for (int it = 0;; ++it) {
     const ForceField load = load_at(t);
     net_force(sys, load, reference, X, r, &K, &diag, 1.0);
@@ -1194,7 +1202,9 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     const double e0 = energy_known ? known_energy : total_energy(sys, next_load, reference, X);
     const double slope = rn.dot(dx);
     double alpha = 1, e_trial = 0;
-    Eigen::MatrixXd Xt = X;
+    // The trials differ from X in the set's rows only, which every trial
+    // writes: one copy per solve, not per step.
+    if (Xt.size() == 0) Xt = X;
     for (int ls = 0; ls < 12; ++ls) {
       trial = x0 + alpha * dx;
       scatter_rows(sys, trial, Xt);
