@@ -15,6 +15,7 @@
 #include "fap/fap_mapping.h"
 #include "fap/fap_synthesis.h"
 #include "fap/fidelity_report.h"
+#include "core/atomic_file.h"
 #include "io/load_face.h"
 #include "render/anatomy_render.h"
 
@@ -125,9 +126,13 @@ void usage(FILE *out) {
       "                          is not a terminal)\n"
       "  --help                  this text\n"
       "\n"
+      "Every output (-o, --report, the pictures) is checked before the work starts:\n"
+      "a path that cannot be written is refused at once, not after the build. Files\n"
+      "appear whole or not at all.\n"
+      "\n"
       "Exit status: 0 on success (FAPs that cannot be made are reported, not fatal), 1\n"
-      "on bad input or a solve that does not converge (the message says which and\n"
-      "why), 2 on bad usage.\n", kDefaultSimVertices, kMaxFapScale);
+      "on bad input, an output that cannot be written or a solve that does not\n"
+      "converge (the message says which and why), 2 on bad usage.\n", kDefaultSimVertices, kMaxFapScale);
 }
 
 bool stderr_is_terminal() {
@@ -328,6 +333,16 @@ int main(int argc, char **argv) {
   if (!pose_png.empty() && !fo.calibrate) return usage_error("--pose needs calibrated muscles (drop --no-calibrate)");
   if (!out_path.empty() && !fo.calibrate) return usage_error("-o needs calibrated muscles (drop --no-calibrate)");
   if (!report_dir.empty() && out_path.empty()) return usage_error("--report needs -o");
+  // Every output checked before the work: a build takes seconds to minutes.
+  {
+    std::vector<std::string> files = {out_path, muscle_map, jaw_map, pose_png};
+    for (const auto &inf : influences) files.push_back(inf.second);
+    for (const std::string &f : files)
+      if (!f.empty())
+        if (Status s = check_writable(f); !s) return fail(s);
+    if (!report_dir.empty())
+      if (Status s = check_fillable_directory(report_dir); !s) return fail(s);
+  }
 
   // A subset of targets calibrates only what it poses (each muscle
   // calibrates on its own: the poses are the same).

@@ -191,4 +191,26 @@ expect_error "bad profile" 2 "use draco or raw" "$tmp/bad.afm" -- "$bin" "$h" "$
 # Bad input: exit 1 naming the file; nothing written.
 expect_error "missing mesh" 1 "missing.wrl" "$tmp/bad.png" -- \
   "$bin" "$tmp/missing.wrl" "$f" --no-calibrate --muscle-map "$tmp/bad.png"
+
+# Outputs that cannot be written: refused before the work (no model summary
+# on stdout), exit 1 naming the path; nothing written.
+before_work() {
+  if grep -q "^skin: " "$tmp/out.txt"; then fail "$1: refused only after the model was built"; fi
+}
+expect_error "AFM into a missing directory" 1 "nodir/h.afm: cannot create" "$tmp/nodir" -- \
+  "$bin" "$h" "$f" -o "$tmp/nodir/h.afm"
+before_work "AFM into a missing directory"
+mkdir -p "$tmp/adir"
+expect_error "AFM onto a directory" 1 "adir: cannot create: it is a directory" - -- "$bin" "$h" "$f" -o "$tmp/adir"
+before_work "AFM onto a directory"
+[ -z "$(ls -A "$tmp/adir")" ] || fail "AFM onto a directory: wrote into it: $(ls -A "$tmp/adir")"
+: >"$tmp/afile"
+expect_error "report onto a file" 1 "afile: not a directory" "$tmp/bad.afm" -- \
+  "$bin" "$h" "$f" -o "$tmp/bad.afm" --report "$tmp/afile"
+before_work "report onto a file"
+expect_error "report under a file" 1 "afile/r: cannot make the directory" "$tmp/bad.afm" -- \
+  "$bin" "$h" "$f" -o "$tmp/bad.afm" --report "$tmp/afile/r"
+expect_error "influence picture into a missing directory" 1 "nodir/z.png: cannot create" "$tmp/nodir" -- \
+  "$bin" "$h" "$f" --no-calibrate --influence zygomaticus_major_left "$tmp/nodir/z.png"
+before_work "influence picture into a missing directory"
 finish
