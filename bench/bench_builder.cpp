@@ -13,6 +13,7 @@
 #include <chrono>
 #include <cstdio>
 #include <algorithm>
+#include <memory>
 #include <cstdlib>
 #include <string>
 
@@ -56,9 +57,14 @@ struct WholeAfm {
   size_t made = 0, tried = 0, under = 0;    // targets made, attempted, short of their reference
   double off = 0;                           // off-axis median, percent
   Expected<std::vector<uint8_t>> bytes = Status::error("not built");
+  SolveCounts work;  // the solver's, summed over every solve (afm-build --stats)
+  // The model's solver options point here: it lives as long as the model.
+  std::shared_ptr<SolveTotals> totals = std::make_shared<SolveTotals>();
 };
-WholeAfm whole_afm(const Scene &scene, const FdpSet &fdps, const FaceModelOptions &fo) {
+WholeAfm whole_afm(const Scene &scene, const FdpSet &fdps, const FaceModelOptions &options) {
   WholeAfm w;
+  FaceModelOptions fo = options;
+  fo.solver.totals = w.totals.get();
   const double t0 = now();
   w.model = build_sim_face_model(scene, fdps, SimMeshOptions{kDefaultSimVertices}, fo);
   if (!w.model) {
@@ -79,6 +85,7 @@ WholeAfm whole_afm(const Scene &scene, const FdpSet &fdps, const FaceModelOption
   w.off = off_median(*st);
   w.bytes = encode_afm(fap_afm_content(scene, fdps, w.model->model, std::move(*st)), AFM_PROFILE_DRACO);
   w.seconds = now() - t0;
+  w.work = w.totals->counts();
   return w;
 }
 
@@ -122,6 +129,8 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
                 "skin; AFM %zu bytes; %zu targets under-reach\n",
                 s.sim.kept.size(), s.notes.size(), by_default.seconds, whole_skin / by_default.seconds,
                 by_default.bytes->size(), by_default.under);
+    // Counted work, which a noisy machine does not blur (afm-build --stats).
+    std::printf("  its solver work: %s\n", by_default.work.text().c_str());
     // The same targets with each group alone (no helpers steering the
     // FDP onto the FAP's direction, fap/steer.h): what the steering costs.
     FapSynthesisOptions alone;
@@ -147,7 +156,8 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
   // solves from rest (below) are another sample: newton-jacobi is faster at
   // them on Song, and 10 times slower at Song's whole AFM, whose solves
   // start from nearby poses and reuse their factorisations.
-  std::printf("%-16s %9s %7s %7s %6s %9s\n", "whole AFM", "seconds", "ratio", "made", "under", "off-axis");
+  std::printf("%-16s %9s %7s %7s %6s %9s %9s %7s\n", "whole AFM", "seconds", "ratio", "made", "under", "off-axis",
+              "steps", "failed");
   const SolverKind default_kind = FaceModelOptions{}.solver.kind;
   for (SolverKind k : kSolverKinds) {
     FaceModelOptions fo;
@@ -158,9 +168,10 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
       std::printf("%-16s failed: %s\n", solver_name(k), w.bytes.status().message().c_str());
       continue;
     }
-    std::printf("%-16s %9.2f %6.1fx %3zu/%zu %6zu %8.1f%%%s\n", solver_name(k), w.seconds,
+    // steps: Newton iterations or time steps over every solve; failed: solves.
+    std::printf("%-16s %9.2f %6.1fx %3zu/%zu %6zu %8.1f%% %9lld %7lld%s\n", solver_name(k), w.seconds,
                 by_default.seconds > 0 ? w.seconds / by_default.seconds : 0.0, w.made, w.tried, w.under, w.off,
-                k == default_kind ? "  (the default, above)" : "");
+                w.work.iterations, w.work.failed, k == default_kind ? "  (the default, above)" : "");
   }
 
   // Time to equilibrium at +100 % from rest, on V_d, factorisations included;

@@ -111,18 +111,23 @@ Status solve_growing(const FaceModel &model, std::vector<int> &set, const ForceF
                 set.end());
   };
   unheld();
-  int total_it = 0, total_cg = 0, total_fact = 0;
-  double total_seconds = 0;
+  SolveStats total;  // the rounds' work summed
   for (int round = 0;; ++round) {
     SolveStats st = solve_equilibrium(skin, set, forces, reference, X, opts, cache, control);
-    total_it += st.iterations;
-    total_cg += st.cg_iterations;
-    total_fact += st.factorisations;
-    total_seconds += st.seconds;
-    st.iterations = total_it;
-    st.cg_iterations = total_cg;
-    st.factorisations = total_fact;
-    st.seconds = total_seconds;
+    total.iterations += st.iterations;
+    total.cg_iterations += st.cg_iterations;
+    total.factorisations += st.factorisations;
+    total.half_steps += st.half_steps;
+    total.assemblies += st.assemblies;
+    total.energies += st.energies;
+    total.seconds += st.seconds;
+    st.iterations = total.iterations;
+    st.cg_iterations = total.cg_iterations;
+    st.factorisations = total.factorisations;
+    st.half_steps = total.half_steps;
+    st.assemblies = total.assemblies;
+    st.energies = total.energies;
+    st.seconds = total.seconds;
     if (stats) *stats = st;
     if (rounds) *rounds = round + 1;
     if (!st.converged) return Status::error(st.message);

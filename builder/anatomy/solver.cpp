@@ -756,6 +756,25 @@ FactorCache::Entry *FactorCache::insert(const std::vector<int> &vertices, bool l
 }
 void FactorCache::clear() { entries_.clear(); }
 
+SolveCounts SolveCounts::operator-(const SolveCounts &o) const {
+  return {solves - o.solves, failed - o.failed, iterations - o.iterations, cg_iterations - o.cg_iterations,
+          factorisations - o.factorisations, assemblies - o.assemblies, energies - o.energies};
+}
+
+std::string SolveCounts::text() const {
+  char b[256];
+  std::snprintf(b, sizeof b,
+                "%lld solves (%lld failed), %lld Newton iterations, %lld CG iterations, %lld factorisations, "
+                "%lld tangents assembled, %lld energies",
+                solves, failed, iterations, cg_iterations, factorisations, assemblies, energies);
+  return b;
+}
+
+SolveCounts SolveTotals::counts() const {
+  return {solves.load(), failed.load(), iterations.load(), cg_iterations.load(), factorisations.load(),
+          assemblies.load(), energies.load()};
+}
+
 const char *solver_name(SolverKind kind) {
   switch (kind) {
     case SolverKind::Newton: return "newton";
@@ -852,6 +871,15 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     st.converged = ok;
     st.message = std::move(message);
     st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (SolveTotals *t = options.totals) {
+      ++t->solves;
+      t->failed += !ok;
+      t->iterations += st.iterations;
+      t->cg_iterations += st.cg_iterations;
+      t->factorisations += st.factorisations;
+      t->assemblies += st.assemblies;
+      t->energies += st.energies;
+    }
     return st;
   };
   const std::string name = solver_name(options.kind);
@@ -883,6 +911,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     Vec mass(n);
     for (size_t i = 0; i < sys.nodes.size(); ++i) mass.segment<3>(3 * static_cast<int>(i)).setConstant(model.mass[sys.nodes[i]]);
     linearise(sys, X, K, diag);
+    ++st.assemblies;
     const double t0 = std::sqrt(mass.mean() / std::max(diag.mean(), 1e-300));
     const double h = options.time_step * t0, gamma = options.damping / t0;
     add_load_stiffness(sys, forces, X, K, diag);
@@ -890,6 +919,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     for (int step = 0; step < max_steps; ++step) {
       // The first step's tangent is the one linearised above.
       net_force(sys, forces, reference, X, r, step > 0 ? &K : nullptr, &diag);
+      st.assemblies += step > 0;
       st.residual = displacement_estimate([&] { Vec f = r; contacts.filter(f); return f; }(), diag);
       if (!finite(r)) return done(false, "implicit-euler: non-finite force at step " + std::to_string(step));
       if (step > 0 && st.residual < tol && st.last_step < tol) {
@@ -996,6 +1026,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
   for (int it = 0;; ++it) {
     const ForceField load = load_at(t);
     net_force(sys, load, reference, X, r, &K, &diag, 1.0);
+    ++st.assemblies;
     if (!finite(r)) return done(false, name + ": non-finite force");
     Vec rf = r;
     contacts.filter(rf);
@@ -1058,6 +1089,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
       if (tangent == Tangent::Half) half_failed = true;
       tangent = tangent == Tangent::Full && options.half_tangent && !half_failed ? Tangent::Half : Tangent::Projected;
       linearise(sys, X, K, diag, tangent == Tangent::Half ? kHalfCurvature : 0.0);
+      ++st.assemblies;
       add_load_stiffness(sys, load, X, K, diag);
     };
     auto shifted = [&] {
@@ -1199,6 +1231,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     Vec rn = rf;
     if (control) rn += dt * [&] { Vec gf = g; contacts.filter(gf); return gf; }();
     x0 = gather_rows(sys, X);
+    st.energies += !energy_known;
     const double e0 = energy_known ? known_energy : total_energy(sys, next_load, reference, X);
     const double slope = rn.dot(dx);
     double alpha = 1, e_trial = 0;
@@ -1209,6 +1242,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
       trial = x0 + alpha * dx;
       scatter_rows(sys, trial, Xt);
       e_trial = total_energy(sys, next_load, reference, Xt);
+      ++st.energies;
       if ((std::isfinite(e_trial) && e_trial <= e0 - 1e-4 * alpha * std::max(slope, 0.0)) || ls == 11) break;
       alpha *= 0.5;
     }
@@ -1223,6 +1257,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
         const Vec further = x0 + longer * dx;
         scatter_rows(sys, further, Xt);
         const double e = total_energy(sys, next_load, reference, Xt);
+        ++st.energies;
         if (!(std::isfinite(e) && e < e_taken)) break;
         e_taken = e, trial = further, alpha = longer;
       }

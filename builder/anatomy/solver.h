@@ -130,6 +130,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <atomic>
 #include <functional>
 #include <map>
 #include <memory>
@@ -146,6 +147,28 @@ constexpr SolverKind kSolverKinds[] = {SolverKind::Newton, SolverKind::NewtonRes
 // "newton", "newton-rest", "implicit-euler", "newton-jacobi"
 const char *solver_name(SolverKind kind);
 bool solver_from_name(const std::string &name, SolverKind *kind);
+
+// Solver work as plain numbers: SolveStats' counts summed over solves
+// (SolveTotals::counts()).
+struct SolveCounts {
+  long long solves = 0, failed = 0, iterations = 0, cg_iterations = 0, factorisations = 0, assemblies = 0,
+            energies = 0;
+  SolveCounts operator-(const SolveCounts &o) const;  // the work between two snapshots
+  // "S solves (F failed), I Newton iterations, C CG iterations, ..."
+  std::string text() const;
+};
+
+// Work summed over the solves that share it (SolverOptions::totals): each
+// solve adds its counts (SolveStats) when it ends, converged or not.
+// Thread-safe: a builder's workers add to one. Deterministic for a
+// deterministic sequence of solves (one worker); with several, a solve's
+// warm start may depend on what its worker solved before it, and the counts
+// with it, while the results do not.
+struct SolveTotals {
+  std::atomic<long long> solves{0}, failed{0}, iterations{0}, cg_iterations{0}, factorisations{0}, assemblies{0},
+      energies{0};
+  SolveCounts counts() const;  // a snapshot
+};
 
 struct SolverOptions {
   SolverKind kind = SolverKind::Newton;
@@ -179,6 +202,8 @@ struct SolverOptions {
   // the pressed lips). On for poses of several groups at once: visemes and
   // expressions.
   bool lip_contact = false;
+  // Not owned; when set, every solve adds its work to it (afm-build --stats).
+  SolveTotals *totals = nullptr;
 };
 
 struct SolveStats {
@@ -187,6 +212,8 @@ struct SolveStats {
   int cg_iterations = 0;  // summed over every linear solve
   int factorisations = 0; // numeric factorisations of the tangent (newton)
   int half_steps = 0;     // Newton steps made on the half tangent (SolverOptions::half_tangent)
+  int assemblies = 0;     // tangents assembled (each with the force at the same positions, or alone)
+  int energies = 0;       // total energies evaluated (the newton solvers' line search)
   int unknowns = 0;       // 3 x free nodes
   int contacts = 0;       // nodes held on the skull at the end
   double residual = 0;    // the Jacobi displacement estimate at the end, model units

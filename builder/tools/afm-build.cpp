@@ -121,6 +121,10 @@ void usage(FILE *out) {
       "                          drivers, the 2 nostril dilators, the chin raiser, the\n"
       "                          2 depressores supercilii and the 2 depressores labii\n"
       "                          inferioris, their key points\n"
+      "  --stats                 also print the solver's work, summed over every solve\n"
+      "                          (calibration, then targets): solves, Newton iterations,\n"
+      "                          CG iterations, factorisations, tangents assembled,\n"
+      "                          energies; the same on every run with --threads 1\n"
       "  -q, --quiet             no progress on stderr (else one line rewritten in\n"
       "                          place, or a line per tenth of the work when stderr\n"
       "                          is not a terminal)\n"
@@ -176,7 +180,8 @@ int main(int argc, char **argv) {
   double jaw_open = 0;
   LoadOptions lo;
   FaceModelOptions fo;
-  bool quiet = false, list = false, list_faps = false;
+  bool quiet = false, list = false, list_faps = false, stats = false;
+  SolveTotals totals;
   std::string out_path, report_dir;
   afm_profile profile = AFM_PROFILE_DRACO;
   FapSynthesisOptions so;
@@ -296,6 +301,8 @@ int main(int argc, char **argv) {
       report_dir = value("--report");
     } else if (a == "--list-faps") {
       list_faps = true;
+    } else if (a == "--stats") {
+      stats = true;
     } else if (a == "-q" || a == "--quiet") {
       quiet = true;
     } else if (a.size() > 1 && a[0] == '-') {
@@ -354,6 +361,7 @@ int main(int argc, char **argv) {
     fo.calibrate_jaw = need.jaw || jaw_open > 0;
   }
 
+  if (stats) fo.solver.totals = &totals;
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<std::string> log;
   Expected<LoadedFace> face = load_face(mesh_path, fdp_path, lo, &log);
@@ -419,6 +427,8 @@ int main(int argc, char **argv) {
               j.vertices.size(), j.ray_hits.size(), j.removed, j.added, j.followers.size(), j.dynamic.size(), j.pivot.x(),
               j.pivot.y(), j.pivot.z());
   std::printf("built in %.2f s\n", seconds);
+  const SolveCounts before = totals.counts();
+  if (stats) std::printf("solver work (the model): %s\n", before.text().c_str());
 
   if (!muscle_map.empty()) {
     if (Status s = render_muscle_map_png(scene, *model, muscle_map); !s) return fail(s);
@@ -485,5 +495,7 @@ int main(int argc, char **argv) {
                 content.rigids.size(),
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count());
   }
+  if (stats && (!out_path.empty() || !pose_png.empty() || !contractions.empty() || jaw_open > 0))
+    std::printf("solver work (after the model): %s\n", (totals.counts() - before).text().c_str());
   return 0;
 }

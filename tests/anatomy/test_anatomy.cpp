@@ -1649,6 +1649,40 @@ TEST(Solver, NeverReportsAnUnconvergedResultAsConverged) {
   EXPECT_TRUE(X.allFinite());
 }
 
+TEST(Solver, TotalsAddUpTheWorkOfEverySolveThatSharesThem) {
+  // afm-build --stats: every solve adds its counts to the options' totals
+  // when it ends, a failed one too.
+  const FaceModel &m = head_1k().model;
+  const Muscle &mu = m.muscles[static_cast<size_t>(m.find("zygomaticus_major_left"))];
+  ForceField f = [&](const Eigen::MatrixXd &X, Eigen::MatrixXd *F, NodeBlocks *K) { return muscle_load(m.tissue, mu, 0.3, X, F, K); };
+  SolveTotals totals;
+  SolverOptions so = m.solver;
+  so.totals = &totals;
+  FactorCache cache;
+  Eigen::MatrixXd X = m.tissue.X0;
+  const SolveStats a = solve_equilibrium(m.tissue, all_vertices(m.tissue), f, m.tissue.X0, X, so, &cache);
+  ASSERT_TRUE(a.converged) << a.message;
+  so.max_iterations = 1;
+  X = m.tissue.X0;
+  const SolveStats b = solve_equilibrium(m.tissue, all_vertices(m.tissue), f, m.tissue.X0, X, so, nullptr);
+  ASSERT_FALSE(b.converged);
+  // A tangent per Newton iteration at least (more where the full one is
+  // indefinite), and the line search measured energies.
+  EXPECT_GE(a.assemblies, a.iterations);
+  EXPECT_GT(a.energies, 0);
+  EXPECT_GT(a.factorisations, 0);
+  EXPECT_EQ(totals.solves.load(), 2);
+  EXPECT_EQ(totals.failed.load(), 1);
+  EXPECT_EQ(totals.iterations.load(), a.iterations + b.iterations);
+  EXPECT_EQ(totals.cg_iterations.load(), a.cg_iterations + b.cg_iterations);
+  EXPECT_EQ(totals.factorisations.load(), a.factorisations + b.factorisations);
+  EXPECT_EQ(totals.assemblies.load(), a.assemblies + b.assemblies);
+  EXPECT_EQ(totals.energies.load(), a.energies + b.energies);
+  std::printf("two solves: %lld Newton iterations, %lld tangents, %lld energies, %lld factorisations\n",
+              totals.iterations.load(), totals.assemblies.load(), totals.energies.load(),
+              totals.factorisations.load());
+}
+
 TEST(Solver, LongerStepsCutTheCrawlOnAStiffSkin) {
   // bench_builder's stiffness case on the 1k head: the epidermis 10 times
   // stiffer. Frontalis inner pulls the forehead up; Newton's steps on the

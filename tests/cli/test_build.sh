@@ -157,6 +157,17 @@ echo "$d" | awk '{ exit !($1 > 0.003 && $2 < 0.1 * $1 && $3 < 0.1 * $1 && $3 > -
   fail "open_jaw opens the mouth (drop of 2.1, 2.2, 2.3 in model units: $d)"
 
 # Placement only: the summary and three pictures.
+# --stats: the solver's work, the model's and the targets', the same on
+# every run at one worker.
+for run in 1 2; do
+  "$bin" "$tmp/h.wrl" "$tmp/h.fdp" -q --faps 12 --threads 1 --stats -o "$tmp/s$run.afm" >"$tmp/stats$run.txt" 2>&1 ||
+    fail "a --stats build failed: $(tail -n 3 "$tmp/stats$run.txt")"
+  grep "^solver work" "$tmp/stats$run.txt" >"$tmp/work$run.txt"
+done
+grep -Eq "^solver work \(the model\): [1-9][0-9]* solves \(0 failed\), [1-9][0-9]* Newton iterations, [0-9]+ CG iterations, [1-9][0-9]* factorisations, [1-9][0-9]* tangents assembled, [1-9][0-9]* energies$" "$tmp/work1.txt" ||
+  fail "--stats: no line for the model's work: $(cat "$tmp/stats1.txt")"
+grep -Eq "^solver work \(after the model\): [1-9][0-9]* solves" "$tmp/work1.txt" || fail "--stats: no line for the targets' work"
+cmp -s "$tmp/work1.txt" "$tmp/work2.txt" || fail "--stats: two runs at one worker differ: $(cat "$tmp/work1.txt" "$tmp/work2.txt")"
 "$bin" "$tmp/h.wrl" "$tmp/h.fdp" --no-calibrate -q --muscle-map "$tmp/map.png" \
   --influence zygomaticus_major_left "$tmp/zyg.png" --jaw-map "$tmp/jaw.png" >"$tmp/out.txt" 2>&1 ||
   fail "a placement run failed: $(cat "$tmp/out.txt")"
