@@ -12,10 +12,10 @@
 #include "anatomy/face_model.h"
 #include "anatomy/muscle_table.h"
 #include "anatomy/sim_mesh.h"
+#include "core/atomic_file.h"
 #include "fap/fap_mapping.h"
 #include "fap/fap_synthesis.h"
 #include "fap/fidelity_report.h"
-#include "core/atomic_file.h"
 #include "io/load_face.h"
 #include "render/anatomy_render.h"
 

@@ -156,7 +156,6 @@ d=$(drops open_jaw)
 echo "$d" | awk '{ exit !($1 > 0.003 && $2 < 0.1 * $1 && $3 < 0.1 * $1 && $3 > -0.1 * $1) }' ||
   fail "open_jaw opens the mouth (drop of 2.1, 2.2, 2.3 in model units: $d)"
 
-# Placement only: the summary and three pictures.
 # --stats: the solver's work, the model's and the targets', the same on
 # every run at one worker.
 for run in 1 2; do
@@ -168,6 +167,8 @@ grep -Eq "^solver work \(the model\): [1-9][0-9]* solves \(0 failed\), [1-9][0-9
   fail "--stats: no line for the model's work: $(cat "$tmp/stats1.txt")"
 grep -Eq "^solver work \(after the model\): [1-9][0-9]* solves" "$tmp/work1.txt" || fail "--stats: no line for the targets' work"
 cmp -s "$tmp/work1.txt" "$tmp/work2.txt" || fail "--stats: two runs at one worker differ: $(cat "$tmp/work1.txt" "$tmp/work2.txt")"
+
+# Placement only: the summary and three pictures.
 "$bin" "$tmp/h.wrl" "$tmp/h.fdp" --no-calibrate -q --muscle-map "$tmp/map.png" \
   --influence zygomaticus_major_left "$tmp/zyg.png" --jaw-map "$tmp/jaw.png" >"$tmp/out.txt" 2>&1 ||
   fail "a placement run failed: $(cat "$tmp/out.txt")"
