@@ -111,23 +111,11 @@ Status solve_growing(const FaceModel &model, std::vector<int> &set, const ForceF
                 set.end());
   };
   unheld();
-  SolveStats total;  // the rounds' work summed
+  SolveStats earlier;  // the earlier rounds' work
   for (int round = 0;; ++round) {
     SolveStats st = solve_equilibrium(skin, set, forces, reference, X, opts, cache, control);
-    total.iterations += st.iterations;
-    total.cg_iterations += st.cg_iterations;
-    total.factorisations += st.factorisations;
-    total.half_steps += st.half_steps;
-    total.assemblies += st.assemblies;
-    total.energies += st.energies;
-    total.seconds += st.seconds;
-    st.iterations = total.iterations;
-    st.cg_iterations = total.cg_iterations;
-    st.factorisations = total.factorisations;
-    st.half_steps = total.half_steps;
-    st.assemblies = total.assemblies;
-    st.energies = total.energies;
-    st.seconds = total.seconds;
+    add_work(st, earlier);  // the last round's stats with every round's work
+    earlier = st;
     if (stats) *stats = st;
     if (rounds) *rounds = round + 1;
     if (!st.converged) return Status::error(st.message);

@@ -770,6 +770,16 @@ std::string SolveCounts::text() const {
   return b;
 }
 
+void add_work(SolveStats &into, const SolveStats &more) {
+  into.iterations += more.iterations;
+  into.cg_iterations += more.cg_iterations;
+  into.factorisations += more.factorisations;
+  into.half_steps += more.half_steps;
+  into.assemblies += more.assemblies;
+  into.energies += more.energies;
+  into.seconds += more.seconds;
+}
+
 SolveCounts SolveTotals::counts() const {
   return {solves.load(), failed.load(), iterations.load(), cg_iterations.load(), factorisations.load(),
           assemblies.load(), energies.load()};
@@ -1085,6 +1095,8 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
     // every muscle on Song (36 % before) and 29 % on the 10k head (33 %);
     // docs/anatomy.md, "Solver and stopping rule".
     enum class Tangent { Full, Half, Shifted, Projected } tangent = Tangent::Full;
+    // The full and the half tangent are kept only where definite.
+    auto definite_only = [&] { return tangent == Tangent::Full || tangent == Tangent::Half; };
     auto project = [&] {
       if (tangent == Tangent::Half) half_failed = true;
       tangent = tangent == Tangent::Full && options.half_tangent && !half_failed ? Tangent::Half : Tangent::Projected;
@@ -1118,14 +1130,12 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
       for (;;) {
         copy_values(K, Kf);
         contacts.filter(sys, Kf);
-        // The full and the half tangent's factorisations are kept only where
-        // definite: they stop at the first indefinite pivot.
-        const bool definite_only = tangent == Tangent::Full || tangent == Tangent::Half;
-        const Ldlt::Result res = entry->symbolic.factorize(Kf, definite_only);
+        // The full and the half tangent's stop at the first indefinite pivot.
+        const Ldlt::Result res = entry->symbolic.factorize(Kf, definite_only());
         ++st.factorisations;
         const bool ok = res != Ldlt::Result::kSingular;
         entry->factored = entry->symbolic.complete();
-        if (ok && (!definite_only || res == Ldlt::Result::kDefinite)) break;
+        if (ok && (!definite_only() || res == Ldlt::Result::kDefinite)) break;
         if (tangent == Tangent::Projected) return false;
         if (tangent == Tangent::Full && projected_run >= 2 && shifted()) break;
         project();
@@ -1166,7 +1176,7 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
         fresh = true;
         continue;
       }
-      if (!indefinite || (tangent != Tangent::Full && tangent != Tangent::Half)) break;
+      if (!indefinite || !definite_only()) break;
       project();  // CG met a direction of negative curvature
     }
     if (control) {

@@ -222,6 +222,10 @@ struct SolveStats {
   std::string message;    // why it failed; empty when converged
 };
 
+// Adds `more`'s work (the counts from iterations to energies, and the
+// seconds) to `into`'s; the rest of `into` stays.
+void add_work(SolveStats &into, const SolveStats &more);
+
 // The Hessian of a load's potential, as 3 x 3 blocks on single nodes
 // (global node index, block): the loads here act node by node.
 using NodeBlocks = std::vector<std::pair<int, Eigen::Matrix3d>>;

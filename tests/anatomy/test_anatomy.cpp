@@ -75,6 +75,14 @@ std::vector<int> all_vertices(const SkinModel &s) {
   return v;
 }
 
+// A solve on `set` from rest (X0 into X), with a cache of its own.
+SolveStats solve_from_rest(const FaceModel &model, const std::vector<int> &set, const ForceField &f,
+                           const SolverOptions &so, Eigen::MatrixXd &X) {
+  X = model.tissue.X0;
+  FactorCache cache;
+  return solve_equilibrium(model.tissue, set, f, model.tissue.X0, X, so, &cache);
+}
+
 // Contracts muscle `name` at signed tension t on the whole skin.
 Eigen::MatrixXd contract(const FaceModel &model, const std::string &name, double t, SolveStats *stats = nullptr,
                          SolverKind kind = SolverKind::Newton) {
@@ -82,11 +90,10 @@ Eigen::MatrixXd contract(const FaceModel &model, const std::string &name, double
   EXPECT_GE(i, 0) << name;
   const Muscle &m = model.muscles[static_cast<size_t>(i)];
   ForceField f = [&](const Eigen::MatrixXd &X, Eigen::MatrixXd *F, NodeBlocks *K) { return muscle_load(model.tissue, m, t, X, F, K); };
-  Eigen::MatrixXd X = model.tissue.X0;
+  Eigen::MatrixXd X;
   SolverOptions so = model.solver;
   so.kind = kind;
-  FactorCache cache;
-  SolveStats st = solve_equilibrium(model.tissue, all_vertices(model.tissue), f, model.tissue.X0, X, so, &cache);
+  SolveStats st = solve_from_rest(model, all_vertices(model.tissue), f, so, X);
   EXPECT_TRUE(st.converged) << name << ": " << st.message;
   if (stats) *stats = st;
   return X;
@@ -1658,13 +1665,11 @@ TEST(Solver, TotalsAddUpTheWorkOfEverySolveThatSharesThem) {
   SolveTotals totals;
   SolverOptions so = m.solver;
   so.totals = &totals;
-  FactorCache cache;
-  Eigen::MatrixXd X = m.tissue.X0;
-  const SolveStats a = solve_equilibrium(m.tissue, all_vertices(m.tissue), f, m.tissue.X0, X, so, &cache);
+  Eigen::MatrixXd X;
+  const SolveStats a = solve_from_rest(m, all_vertices(m.tissue), f, so, X);
   ASSERT_TRUE(a.converged) << a.message;
   so.max_iterations = 1;
-  X = m.tissue.X0;
-  const SolveStats b = solve_equilibrium(m.tissue, all_vertices(m.tissue), f, m.tissue.X0, X, so, nullptr);
+  const SolveStats b = solve_from_rest(m, all_vertices(m.tissue), f, so, X);
   ASSERT_FALSE(b.converged);
   // A tangent per Newton iteration at least (more where the full one is
   // indefinite), and the line search measured energies.
@@ -1705,9 +1710,7 @@ TEST(Solver, LongerStepsCutTheCrawlOnAStiffSkin) {
   for (int extend = 0; extend < 2; ++extend) {
     SolverOptions so = m->solver;
     so.extend_steps = extend == 1;
-    X[extend] = m->tissue.X0;
-    FactorCache cache;
-    st[extend] = solve_equilibrium(m->tissue, all_vertices(m->tissue), f, m->tissue.X0, X[extend], so, &cache);
+    st[extend] = solve_from_rest(*m, all_vertices(m->tissue), f, so, X[extend]);
     ASSERT_TRUE(st[extend].converged) << st[extend].message;
   }
   EXPECT_LT((X[1] - X[0]).cwiseAbs().maxCoeff(), m->quantum);
@@ -1746,9 +1749,7 @@ TEST(Solver, TheHalfTangentCutsTheCrawlOnAStiffSkin) {
     for (int half = 0; half < 2; ++half) {
       SolverOptions so = m->solver;
       so.half_tangent = half == 1;
-      X[half] = m->tissue.X0;
-      FactorCache cache;
-      const SolveStats st = solve_equilibrium(m->tissue, mu.dynamic, f, m->tissue.X0, X[half], so, &cache);
+      const SolveStats st = solve_from_rest(*m, mu.dynamic, f, so, X[half]);
       ASSERT_TRUE(st.converged) << name << ": " << st.message;
       iterations[half] += st.iterations;
       half_steps[half] += st.half_steps;
