@@ -327,6 +327,44 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     if (sim) f.lifted_turned_faces = lifted_turned_faces(*sim, E - skin.X0.topRows(skin.n), &f.lifted_turned_share);
     return f;
   };
+  // A FAP's target is stored with its slivers untangled (untangle.h; below,
+  // after the solves): the FAP's FDP keeps the motion it was measured by, and
+  // the skin the solver holds off an eyeball is held (a patch of Song's
+  // closing upper lid, moved affinely, left a hole in it; only a sliver's
+  // corner there may move).
+  const Eigen::MatrixXd rest = skin.X0.topRows(skin.n);
+  std::vector<char> held(static_cast<size_t>(skin.n), kUntangleFree);
+  for (int v = 0; v < skin.n; ++v)
+    if (skin.eye_near[static_cast<size_t>(v)] >= 0) held[static_cast<size_t>(v)] = kUntangleHeld;
+  auto target_hold = [&held](int fdp) {
+    std::vector<char> hold = held;
+    if (fdp >= 0) hold[static_cast<size_t>(fdp)] = kUntangleFixed;
+    return hold;
+  };
+  // What is wrong with epidermis E as the target of the FAP whose FDP is
+  // skin vertex `fdp`: its faults once untangled, as it would be stored. The
+  // searches past a group's range judge a pose by it: judged by its raw
+  // slivers, Song's nose wings narrowed stopped at 49 % of the reference and
+  // its outer lower lip lowered at 88 %, each for a triangle or two the
+  // untangling straightens. Not at the lip corners, which streams send
+  // together with the jaw and every lip FAP: Song's corners stretched then
+  // reached the reference (65 % before), and joy.fap, which sends them to
+  // 1.6 times it with the corners raised, turned up to 3 triangles at them
+  // in 31 of its 108 frames, none of the targets alone. Nor where the skin
+  // tears (SkinFaults::tears): that is no sliver.
+  std::vector<char> corner(static_cast<size_t>(skin.n), 0);
+  for (int fap = 3; fap <= AFM_FAP_COUNT; ++fap)
+    if (const afm_fap_info *info = afm_fap(fap); info && lip_corner_fdp(info))
+      if (const int v = fdp_vertex(model, info); v >= 0) corner[static_cast<size_t>(v)] = 1;
+  auto target_faults = [&](const Eigen::MatrixXd &E, int fdp) {
+    SkinFaults f = face_faults(E);
+    if ((f.turned_faces.empty() && f.lifted_turned_faces.empty()) || f.tears() ||
+        (fdp >= 0 && corner[static_cast<size_t>(fdp)]))
+      return f;
+    Eigen::MatrixXd D = E - rest;
+    untangle(rest, skin.F, target_hold(fdp), options.sim, D);
+    return face_faults(rest + D);
+  };
 
   // How far the input's skin, lifted from a coarse displacement Dc (#Vc x
   // 3), sinks below the clearance the solver would hold it at off the
@@ -360,10 +398,10 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         for (int j = 0; j < 3; ++j)
           bound = bound || (sim->binding.weight(v, j) > 0 && tarsus[static_cast<size_t>(sim->binding.corner(v, j))]);
         if (!bound) continue;
-        const double rest = (sim->skin_V.row(v).transpose() - ball.centre).norm() - ball.radius;
+        const double gap = (sim->skin_V.row(v).transpose() - ball.centre).norm() - ball.radius;
         const double longest_v = longest[static_cast<size_t>(v)];
-        const double held = rest_eye_clearance(rest, longest_v * longest_v, ball.radius);
-        worst = std::max(worst, ball.radius + held - (E.row(v).transpose() - ball.centre).norm());
+        const double clearance = rest_eye_clearance(gap, longest_v * longest_v, ball.radius);
+        worst = std::max(worst, ball.radius + clearance - (E.row(v).transpose() - ball.centre).norm());
       }
       return worst;
     };
@@ -723,7 +761,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       return false;
     const double reach = action(q->X, nullptr);
     if (r.capped && !(reach >= unit_of && reach < value)) return false;
-    if (!r.faults && face_faults(pose_epidermis(model, *q)).any()) return false;
+    if (!r.faults && target_faults(pose_epidermis(model, *q), vertex).any()) return false;
     pose = std::move(*q);
     o.scale = scale;
     o.mirrored = true;
@@ -987,7 +1025,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
           Expected<Pose> pz = solve_pose_to(model, pattern, action, value, &cache, &scale, cap, &capped,
                                             first.pose ? &first : nullptr);
           std::string beyond_why;  // why the group stayed within its range
-          if (pz && capped && face_faults(pose_epidermis(model, *pz)).any()) {
+          if (pz && capped && target_faults(pose_epidermis(model, *pz), fdp->vertex).any()) {
             beyond_why = "the skin folds or sinks into the skull already at them";
           } else if (pz && capped && action(pz->X, nullptr) <= 0) {
             // The load control steers an action that grows with the load; one
@@ -1014,7 +1052,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
             Expected<Pose> beyond = past_range(kMaxFapScale, &s2, &capped2);
             if (!beyond) {
               beyond_why = "beyond it the solve fails";
-            } else if (face_faults(pose_epidermis(model, *beyond)).any()) {
+            } else if (target_faults(pose_epidermis(model, *beyond), fdp->vertex).any()) {
               // Short of the fold there may be a face. Where the chord from
               // the pose at s = 1 to the folding one first folds guesses where
               // the poses between do; one solve goes to 3/4 of that share of
@@ -1029,12 +1067,13 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
               if (action(pz->X, nullptr) >= unit) {
                 const Eigen::MatrixXd E1 = pose_epidermis(model, *pz), E2 = pose_epidermis(model, *beyond);
                 int steps = kChordSteps;  // of the chord that stay a face, at most
-                while (steps > 1 && face_faults(E1 + (steps * 1.0 / kChordSteps) * (E2 - E1)).any()) --steps;
+                while (steps > 1 && target_faults(E1 + (steps * 1.0 / kChordSteps) * (E2 - E1), fdp->vertex).any())
+                  --steps;
                 const double share = kChordShare * steps / kChordSteps;
                 double s3 = 0;
                 bool capped3 = false;
                 Expected<Pose> p = past_range(scale + share * (s2 - scale), &s3, &capped3);
-                if (p && !face_faults(pose_epidermis(model, *p)).any()) {
+                if (p && !target_faults(pose_epidermis(model, *p), fdp->vertex).any()) {
                   pz = std::move(p);
                   scale = cap = s3;
                   char why[96];
@@ -1051,6 +1090,9 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
           // steer the FDP back (steer.h). Not on a fallback group.
           std::string steered;
           std::vector<std::pair<int, double>> steered_pattern = pattern;
+          // Judged by their raw skin (target_faults above): steered into
+          // slivers the untangling straightens, Song's upper lip sides
+          // summed in joy.fap's frames to a turned triangle at the corner.
           if (pz && !fallback && !map->helpers.empty() && options.steer)
             steered = steer_group(model, map->helpers, pattern, fdp->vertex, side * dir, action, value, cap, &cache,
                                   face_faults, *pz, scale, capped, &steered_pattern);
@@ -1060,7 +1102,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
             ok = true;
             if (has_twin[k] && !fallback)
               recipes[k] = Recipe{steered_pattern, scale, cap, pose, miss_of(pose, fdp->vertex, along, value, false),
-                                  face_faults(pose_epidermis(model, pose)).any(), false, std::string()};
+                                  target_faults(pose_epidermis(model, pose), fdp->vertex).any(), false, std::string()};
           } else {
             // The target is then the most the group does at the cap. Where
             // the load control failed (the FDP moves the wrong way), a plain
@@ -1104,7 +1146,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
                   o.message = reaches_message(o.reached, why);
                   if (has_twin[k] && !fallback && at_cap)
                     recipes[k] = Recipe{steered_pattern, scale, cap, pose, miss_of(pose, fdp->vertex, along, value, true),
-                                        face_faults(pose_epidermis(model, pose)).any(), true, why};
+                                        target_faults(pose_epidermis(model, pose), fdp->vertex).any(), true, why};
                 }
                 ok = true;
               }
@@ -1126,7 +1168,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       if (lid.muscle >= 0 && !lid_cut) {
         const FapOutcome driven = o;
         const double driven_shrink = shrink;
-        if (turn_lid(lid) && o.reached == 1 && !face_faults(pose_epidermis(model, pose)).any()) {
+        if (turn_lid(lid) && o.reached == 1 && !target_faults(pose_epidermis(model, pose), fdp->vertex).any()) {
           ok = true;
           o.message += std::string(o.message.empty() ? "" : "; ") +
                        "the lid turned as a whole (its driver's load reaches " +
@@ -1418,14 +1460,8 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       carry(D, t);
     }
   }
-  // The slivers a target turns over are untangled (untangle.h). A FAP's
-  // FDP keeps the motion it was measured by, and the skin the solver holds
-  // off an eyeball is held: a patch of Song's closing upper lid, moved
-  // affinely, left a hole in it; only a sliver's corner there may move.
-  const Eigen::MatrixXd rest = skin.X0.topRows(skin.n);
-  std::vector<char> held(static_cast<size_t>(skin.n), kUntangleFree);
-  for (int v = 0; v < skin.n; ++v)
-    if (skin.eye_near[static_cast<size_t>(v)] >= 0) held[static_cast<size_t>(v)] = kUntangleHeld;
+  // The slivers a target turns over are untangled (untangle.h; target_hold
+  // above).
   std::vector<RigidSample> jaw_samples;
   // Reach, then hold (fap_synthesis.h): the sides that store an
   // under-reaching pose twice.
@@ -1545,10 +1581,8 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     if (r.target && r.target->displacement[static_cast<size_t>(model.skin)].rows() > 0) {
       MorphTarget &t = *r.target;
       Eigen::MatrixXd &D = t.displacement[static_cast<size_t>(model.skin)];
-      std::vector<char> hold = held;
-      if (const FapMapping *f = work[k].fap)
-        if (const int fdp = fdp_vertex(model, afm_fap(f->fap)); fdp >= 0)
-          hold[static_cast<size_t>(fdp)] = kUntangleFixed;
+      const FapMapping *f = work[k].fap;
+      const std::vector<char> hold = target_hold(f ? fdp_vertex(model, afm_fap(f->fap)) : -1);
       const Untangled u = untangle(rest, skin.F, hold, options.sim, D);
       if (u.moved > 0) {
         for (const SkinBinding &b : carried) t.displacement[static_cast<size_t>(b.part)] = Eigen::MatrixXd();

@@ -364,41 +364,42 @@ TEST(Candide3, SongsBrowSqueezeMovesTheMiddleBrowNoFurtherThanCandidesBlock) {
   EXPECT_EQ(checked, 1) << "FAP 37's positive target";
 }
 
-// Song's upper lip side lowered and raised (FAP 8, FDP 2.6), as Candide-3's
-// FAP 8 block moves it: straight down, the whole reference. Song's upper
-// lip muscle alone, pushed, dents the lip at its insertion (8.10) and turns
-// the skin over at the outer lip with 2.6 down 45 % of the way; its second
-// group (fap_mapping.cpp: with zygomaticus minor, which inserts beside 2.6)
-// takes it all the way. Without the second groups the side under-reaches,
-// which this checks too, so that it is the second group that reaches.
-TEST(Candide3, SongsUpperLipSideComesDownItsWholeReferenceAsCandidesBlockMovesIt) {
+// Song's upper lip sides lowered and raised (FAPs 8 and 9, FDPs 2.6 and
+// 2.7), as Candide-3's blocks move them: straight down or up (cosine over
+// 0.95), within the worst error of the reference along it, 10 %. The
+// upper lip muscle alone, pushed, dents the lip at its insertion (8.10) and
+// once turned the skin over at the outer lip, 2.6 down 45 % of the way; its
+// second group (fap_mapping.cpp: with zygomaticus minor, which inserts
+// beside 2.6) takes a side all the way, and the synthesis keeps whichever
+// target comes nearer the prescribed motion. Judged by their skin as
+// stored, untangled, the upper lip muscle's own poses go further (the
+// fifty-ninth session): Song's left side lowered keeps its own, 92 % of the
+// reference and 5 % off it, against the second group's whole reference and
+// 20 % off; its right side, asymmetric, reaches 69 % alone, and the second
+// group makes it. This checks both sides of both FAPs, that no second group
+// is kept that misses by more than the own group does, and that the second
+// groups make at least one side its own group leaves short of 90 %.
+TEST(Candide3, SongsUpperLipSidesMoveTheirReferenceAsCandidesBlocksMoveThem) {
   AFM_REQUIRE_SHARED_DATA();
   Candide c;
   ASSERT_TRUE(read_candide(afmtest::shared_data("faces/candide3/candide3.wfm"), &c));
-  const CandideBlock *blk = nullptr;
-  for (const CandideBlock &k : c.faps)
-    if (k.fap == 8) blk = &k;
-  ASSERT_TRUE(blk && blk->moves.size() == 1) << "Candide-3's FAP 8 block moves one vertex";
-  const Eigen::Vector3d candide = blk->moves[0].second.normalized();
-
   FapSynthesisOptions o;
-  o.only = {8};
+  o.only = {8, 9};
   const afmtest::SongOnSimMesh song = afmtest::song_on_sim_mesh(calibration_needs(o).muscles);
   ASSERT_FALSE(HasFailure());
   const SimFaceModel &sm = song.built;
   o.sim = &sm.sim;
-  const FdpPoint *p = song.face.fdps.find(FdpId{2, 6}, sm.sim.skin);
-  ASSERT_TRUE(p && p->vertex >= 0);
-  const double value = 120 * fapu_distance(sm.model.fapu, AFM_FAPU_MNS) / 1024.0;
   ASSERT_EQ(find_fap_mapping(8)->reference, 120);
-  // FDP 2.6's motion in each side's target at the table's reference (the
-  // side's only one, or its hold), and whether its message names the
-  // second group.
+  ASSERT_EQ(find_fap_mapping(9)->reference, 120);
+  const double value = 120 * fapu_distance(sm.model.fapu, AFM_FAPU_MNS) / 1024.0;
+  // Each side's target at the table's reference (the side's only one, or
+  // its hold): its FDP's motion, and whether a second group made it.
   struct Side {
     Eigen::Vector3d motion = Eigen::Vector3d::Zero();
     bool found = false, second = false;
   };
-  auto sides = [&](bool second_groups, Side got[2]) {
+  // [fap - 8][0 positive, 1 negative]
+  auto sides = [&](bool second_groups, Side got[2][2]) {
     FapSynthesisOptions oo = o;
     oo.second_groups = second_groups;
     Expected<FapSynthesis> syn = synthesize_faps(sm.scene, sm.model, oo);
@@ -407,30 +408,44 @@ TEST(Candide3, SongsUpperLipSideComesDownItsWholeReferenceAsCandidesBlockMovesIt
     for (const FapOutcome &out : syn->outcomes) {
       if (!out.made) continue;
       const Eigen::MatrixXd &D = syn->targets[next++].displacement[static_cast<size_t>(sm.sim.skin)];
-      if (out.number != 8 || std::abs(out.reference) != 120) continue;
-      Side &s = got[out.side > 0 ? 0 : 1];
+      if ((out.number != 8 && out.number != 9) || std::abs(out.reference) != 120) continue;
+      const FdpPoint *p = song.face.fdps.find(FdpId{2, out.number == 8 ? 6 : 7}, sm.sim.skin);
+      ASSERT_TRUE(p && p->vertex >= 0);
+      Side &s = got[out.number - 8][out.side > 0 ? 0 : 1];
       s.motion = D.row(p->vertex).transpose();
       s.found = true;
       s.second = out.message.find("second group (") != std::string::npos &&
                  out.message.find("came no nearer") == std::string::npos;
     }
   };
-  Side with[2], without[2];
+  Side with[2][2], without[2][2];
   sides(true, with);
   sides(false, without);
   ASSERT_FALSE(HasFailure());
-  for (int k = 0; k < 2; ++k) {
-    const double sign = k == 0 ? 1 : -1;
-    ASSERT_TRUE(with[k].found && without[k].found) << "FAP 8's target at " << sign * 120;
-    const double along = sign * with[k].motion.dot(candide), alone = sign * without[k].motion.dot(candide);
-    std::printf("FAP 8 at %+.0f: 2.6 moves %.3f of %.3f along Candide's block (cosine %.3f); the upper lip "
-                "muscle alone %.3f\n",
-                sign * 120, along, value, sign * cosine(with[k].motion, candide), alone);
-    EXPECT_TRUE(with[k].second) << "side " << sign;
-    EXPECT_GT(along, 0.97 * value);
-    EXPECT_GT(sign * cosine(with[k].motion, candide), 0.95);
-    EXPECT_LT(alone, 0.9 * value) << "the own group reaches: the second group is not what this checks";
+  int rescued = 0;  // sides a second group makes where the own group falls short of 90 %
+  for (int fap : {8, 9}) {
+    const CandideBlock *blk = nullptr;
+    for (const CandideBlock &k : c.faps)
+      if (k.fap == fap) blk = &k;
+    ASSERT_TRUE(blk && blk->moves.size() == 1) << "Candide-3's FAP " << fap << " block moves one vertex";
+    const Eigen::Vector3d candide = blk->moves[0].second.normalized();
+    for (int k = 0; k < 2; ++k) {
+      const double sign = k == 0 ? 1 : -1;
+      const Side &w = with[fap - 8][k], &wo = without[fap - 8][k];
+      ASSERT_TRUE(w.found && wo.found) << "FAP " << fap << "'s target at " << sign * 120;
+      const double along = sign * w.motion.dot(candide), alone = sign * wo.motion.dot(candide);
+      auto miss = [&](const Eigen::Vector3d &m) { return (m - sign * value * candide).norm(); };
+      std::printf("FAP %d at %+.0f: the FDP moves %.3f of %.3f along Candide's block (cosine %.3f)%s; the own "
+                  "group alone %.3f\n",
+                  fap, sign * 120, along, value, sign * cosine(w.motion, candide),
+                  w.second ? ", with its second group" : "", alone);
+      EXPECT_GT(along, 0.9 * value) << "FAP " << fap << " at " << sign * 120;
+      EXPECT_GT(sign * cosine(w.motion, candide), 0.95) << "FAP " << fap << " at " << sign * 120;
+      EXPECT_LE(miss(w.motion), miss(wo.motion) + 1e-9) << "FAP " << fap << " at " << sign * 120;
+      if (w.second && alone < 0.9 * value) ++rescued;
+    }
   }
+  EXPECT_GE(rescued, 1) << "no side needs its second group: the second groups are not what this checks";
 }
 
 }  // namespace
