@@ -1164,7 +1164,8 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       ok = false;
       // A closing lid's driver short of an in-between: the lid turned as a
       // whole, where the skin stays a face (the 2k head's lower lids at 600;
-      // Song's upper lids fold where they meet, and keep none at 1024).
+      // Song's upper lids at 1024 folded where they meet, and kept none, until
+      // target_faults: their driver's load reaches 1024 since).
       if (lid.muscle >= 0 && !lid_cut) {
         const FapOutcome driven = o;
         const double driven_shrink = shrink;

@@ -2224,7 +2224,8 @@ TEST(HighLevel, SongsEyeSphinctersCalibrateAlikeAndKeepTheSkinWhole) {
 
 // Song's left lids, as afm-build makes them: FAPs 19 and 21 get an
 // in-between target at 600 besides the one at 300 (fap_mapping.h: the lids
-// close to 1024 in real streams), both reached in full, and in every target
+// close to 1024 in real streams), and the upper lid one at 1024, each
+// reached in full, and in every target
 // and half-way between two, as the player blends them, no skin vertex of the
 // whole skin (carried from the simulation mesh) goes into its eyeball. Held
 // only where the inward normal meets the ball, the upper lid margin's
@@ -2286,6 +2287,16 @@ TEST(FapSynthesis, SongsLidsCloseOverTheEyeballInBetweenTargetsIncluded) {
     std::printf("FAP %d: deepest into the eyeball at 300 / 450 / 600: %.4f / %.4f / %.4f units\n", fap, deepest(a),
                 deepest(0.5 * (a + b)), deepest(b));
   }
+  // The upper lid shut, at 1024: judged with its slivers untangled, its
+  // driver reaches it (fifty-ninth session; 87 % judged raw, and no target).
+  ASSERT_TRUE(by.count({19, 1024})) << "FAP 19 has its in-between at 1024";
+  const Eigen::MatrixXd &b = by[{19, 600}]->displacement[static_cast<size_t>(skin)];
+  const Eigen::MatrixXd &c = by[{19, 1024}]->displacement[static_cast<size_t>(skin)];
+  ASSERT_EQ(c.rows(), V.rows());
+  EXPECT_LE(deepest(0.5 * (b + c)), sm.model.quantum) << "FAP 19 at 812 (blended)";
+  EXPECT_LE(deepest(c), sm.model.quantum) << "FAP 19 at 1024";
+  std::printf("FAP 19: deepest into the eyeball at 812 / 1024: %.4f / %.4f units\n", deepest(0.5 * (b + c)),
+              deepest(c));
 }
 
 // A FAP's negative side (the one FAP of `o.only`) made on Song's simulation
