@@ -99,13 +99,12 @@
 // the targets' slivers up to folds): face_model.h, skin_faults: no skin
 // triangle turned over, nothing below the skull; on a simulation mesh,
 // none of the lifted skin's either (FapSynthesisOptions::sim). Where it
-// does not, a pose short of
-// the fold that does (one more solve, to 3/4 of the way along which the
-// chord between the two poses keeps the skin a face; not for a group that
-// moves its FDP less than a FAP unit at s = 1); failing that, the pose at
-// s = 1. A group that cannot reach the reference makes
-// its target at that cap: the target under-reaches (the outcome says by how
-// much and why). A group that moves its FDP the wrong way, or by less than a
+// does not, a pose short of the fold that does (one more solve, to 3/4 of
+// the way along which the chord between the two poses keeps the skin a
+// face; not for a group that moves its FDP less than a FAP unit at s = 1);
+// failing that, the pose at s = 1. A group that cannot reach the reference
+// makes its target at that cap: the target under-reaches (the outcome says
+// by how much and why). A group that moves its FDP the wrong way, or by less than a
 // FAP unit, gets no target.
 //
 // Reach, then hold. An under-reaching side's pose is stored twice: scaled
