@@ -2225,9 +2225,9 @@ TEST(HighLevel, SongsEyeSphinctersCalibrateAlikeAndKeepTheSkinWhole) {
 // Song's left lids, as afm-build makes them: FAPs 19 and 21 get an
 // in-between target at 600 besides the one at 300 (fap_mapping.h: the lids
 // close to 1024 in real streams), and the upper lid one at 1024, each
-// reached in full, and in every target
-// and half-way between two, as the player blends them, no skin vertex of the
-// whole skin (carried from the simulation mesh) goes into its eyeball. Held
+// reached in full, and in every target and half-way between two, as the
+// player blends them, no skin vertex of the whole skin (carried from the
+// simulation mesh) goes into its eyeball. Held
 // only where the inward normal meets the ball, the upper lid margin's
 // underside went 0.3 units in at 600, the lifted skin above it 0.13 units at
 // 300; held on the sphere itself, the eye showed through as dark specks.
