@@ -49,7 +49,12 @@ std::vector<FapMapping> make_table() {
   // Song's 8.7 62 % of the reference down and the generated heads' 87-88 %;
   // with the depressors all three reach it. The inner lip's FDPs keep
   // mentalis alone: with the depressors Song's skin folded before 2.3 came
-  // down 35 % (docs/anatomy.md, "Depressor labii inferioris").
+  // down 35 % (docs/anatomy.md, "Depressor labii inferioris"), and the 10k
+  // head's 2.3 reaches 71 % with them, all of it alone. Its middle has them
+  // as a second group: mentalis alone took Song's 2.3 90 % of the way down
+  // and turned 2 triangles; with the depressors it comes the whole way and
+  // turns none (since the fifty-ninth session judged poses with their
+  // slivers untangled). On its sides (10, 11) they turned 2 each.
   for (int outer = 0; outer < 2; ++outer) {
     const int o = outer ? 47 : 0;  // 4 -> 51, 5 -> 52, ... 13 -> 60
     const char *io = outer ? "outer lip" : "inner lip";
@@ -63,6 +68,11 @@ std::vector<FapMapping> make_table() {
         lowered({{"mentalis_left", -100}, {"mentalis_right", -100}},
                 {{"depressor_labii_left", 100}, {"depressor_labii_right", 100}}),
         io);
+    if (!outer)
+      t.back().second_negative = {{"mentalis_left", -100},
+                                  {"mentalis_right", -100},
+                                  {"depressor_labii_left", 100},
+                                  {"depressor_labii_right", 100}};
     add(6 + o, D::Muscles, 70, {{"risorius_left", 100}}, {{"orbicularis_oris", 100}}, io);
     add(7 + o, D::Muscles, 70, {{"risorius_right", 100}}, {{"orbicularis_oris", 100}}, io);
     add(8 + o, D::Muscles, 120, {{"upper_lip_left", 100}}, {{"upper_lip_left", -100}}, io);

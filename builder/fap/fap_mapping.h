@@ -54,7 +54,9 @@ struct FapMapping {
   // too, and its target is kept where it takes the FDP nearer the
   // prescribed motion (|achieved - prescribed|). For a region one muscle
   // moves well only in part: the upper lip muscle, pushed, dents the lip at
-  // its insertion (8.10) before the lip's side (2.6) comes down half way.
+  // its insertion (8.10) before the lip's side (2.6) comes down half way;
+  // mentalis, driven backwards, takes the inner lower lip's middle (2.3)
+  // down most of the way, and its depressors the rest on some faces.
   std::vector<FapContraction> second_positive, second_negative;
   // Eyelid FAPs (19-22) act through their lid's driver (the palpebral part
   // of orbicularis oculi, muscle_table.h), which needs an eye part under the

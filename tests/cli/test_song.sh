@@ -70,9 +70,9 @@ cmp -s "$tmp/fdps_xfaceed.txt" "$tmp/fdps_coords.txt" ||
 # motion's length of its line): the skin between is squeezed to a quarter
 # and less, and where that FDP is another FAP's, the split of shared skin
 # between the inner and outer lip FAPs (builder/fap/fap_partition.h) folds it. On
-# Song those are the lower lip's middle lowered (FAP 5 negative: 2.3 3.03
-# units toward 8.2, 3.49 below it) and its outer line raised (57, 58: 8.7
-# 3.03 toward 2.8, 3.35 above). The lower lip's in-betweens at -1024
+# Song those are the lower lip's outer line raised (57, 58: 8.7 3.03 toward
+# 2.8, 3.35 above); its middle lowered (FAP 5 negative: 2.3 3.03 units toward
+# 8.2, 3.49 below it) was one until its second group (fap_mapping.cpp). The lower lip's in-betweens at -1024
 # (builder/fap/jaw_lips.h) carry its FDPs most of the way to the chin (2.1),
 # which the jaw moves away when the streams send them together (fear.fap
 # turns no more with them: the --folds lines below). The lids' slivers turned

@@ -2491,6 +2491,17 @@ TEST(FapSynthesis, SongsLowerLipComesDownToItsReferenceWithoutAFold) {
   EXPECT_EQ(expect_song_side_lowered(57, {52, 57, 58}, 0.9), 1) << "the target at -350";
 }
 
+// Song's inner lower lip lowered at its middle (FAP 5's negative side, which
+// real streams send with the jaw and the lip's other FAPs): mentalis, driven
+// backwards, took 2.3 90 % of the reference down and turned 2 triangles;
+// its second group adds depressor labii inferioris' pull (fap_mapping.cpp),
+// and made with the lower lip's other FAPs, as in the whole AFM, the middle
+// comes down the whole reference, -350, and folds none of the lifted skin.
+TEST(FapSynthesis, SongsInnerLowerLipComesDownToItsReferenceWithoutAFold) {
+  AFM_REQUIRE_SHARED_DATA();
+  EXPECT_EQ(expect_song_side_lowered(5, {5, 10, 11, 52, 57, 58}, 0.9), 1) << "the target at -350";
+}
+
 // Song's jaw, opened as FAP 3 says, on afm-build's simulation mesh: the
 // skin it stores turns no triangle, and the chin below 2.1 goes down with
 // it. Before, the jaw carried the skin down to 2.1 only, which Song's file
