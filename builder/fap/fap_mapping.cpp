@@ -58,21 +58,18 @@ std::vector<FapMapping> make_table() {
   for (int outer = 0; outer < 2; ++outer) {
     const int o = outer ? 47 : 0;  // 4 -> 51, 5 -> 52, ... 13 -> 60
     const char *io = outer ? "outer lip" : "inner lip";
-    auto lowered = [outer](Group push, Group pull) {
-      if (outer) push.insert(push.end(), pull.begin(), pull.end());
+    auto with = [](Group push, const Group &pull) {
+      push.insert(push.end(), pull.begin(), pull.end());
       return push;
     };
+    auto lowered = [&with, outer](Group push, const Group &pull) { return outer ? with(push, pull) : push; };
     add(4 + o, D::Muscles, 100, {{"upper_lip_left", 100}, {"upper_lip_right", 100}},
         {{"upper_lip_left", -100}, {"upper_lip_right", -100}}, io);
+    const Group middle_push = {{"mentalis_left", -100}, {"mentalis_right", -100}},
+                middle_pull = {{"depressor_labii_left", 100}, {"depressor_labii_right", 100}};
     add(5 + o, D::Muscles, 350, {{"mentalis_left", 100}, {"mentalis_right", 100}},
-        lowered({{"mentalis_left", -100}, {"mentalis_right", -100}},
-                {{"depressor_labii_left", 100}, {"depressor_labii_right", 100}}),
-        io);
-    if (!outer)
-      t.back().second_negative = {{"mentalis_left", -100},
-                                  {"mentalis_right", -100},
-                                  {"depressor_labii_left", 100},
-                                  {"depressor_labii_right", 100}};
+        lowered(middle_push, middle_pull), io);
+    if (!outer) t.back().second_negative = with(middle_push, middle_pull);  // the outer lip's group
     add(6 + o, D::Muscles, 70, {{"risorius_left", 100}}, {{"orbicularis_oris", 100}}, io);
     add(7 + o, D::Muscles, 70, {{"risorius_right", 100}}, {{"orbicularis_oris", 100}}, io);
     add(8 + o, D::Muscles, 120, {{"upper_lip_left", 100}}, {{"upper_lip_left", -100}}, io);
