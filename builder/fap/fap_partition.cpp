@@ -1,10 +1,12 @@
 #include "fap/fap_partition.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <limits>
 #include <numeric>
 
 #include "core/edge_paths.h"
+#include "core/parallel.h"
 
 namespace afmb {
 
@@ -111,6 +113,176 @@ FapPartition partition_shared_targets(const Eigen::MatrixXd &X, const Eigen::Mat
       }
       out.weight[k] = phi.col(own).cwiseQuotient(sum);
     }
+  }
+  return out;
+}
+
+namespace {
+
+// Triangle f's facing under X + w P (fap_partition.h: 1 at rest, below 0
+// turned over) and, when `grad`, its derivatives in its corners' weights.
+// m: the rest normals over their squares (#F x 3; zero where degenerate).
+double facing(const Eigen::MatrixXd &X, const Eigen::MatrixXi &F, const Eigen::MatrixXd &m, const Eigen::VectorXd &w,
+              const Eigen::MatrixXd &P, Eigen::Index f, Eigen::Vector3d *grad) {
+  const int a = F(f, 0), b = F(f, 1), c = F(f, 2);
+  const Eigen::Vector3d Pa = P.row(a).transpose(), Pb = P.row(b).transpose(), Pc = P.row(c).transpose();
+  const Eigen::Vector3d pa = X.row(a).transpose() + w(a) * Pa, pb = X.row(b).transpose() + w(b) * Pb,
+                        pc = X.row(c).transpose() + w(c) * Pc;
+  const Eigen::Vector3d n = m.row(f).transpose();
+  if (grad) *grad = Eigen::Vector3d(Pa.cross(pb - pc).dot(n), Pb.cross(pc - pa).dot(n), Pc.cross(pa - pb).dot(n));
+  return n.isZero() ? 1 : (pb - pa).cross(pc - pa).dot(n);  // degenerate at rest: nothing to keep
+}
+
+}  // namespace
+
+UnfoldedShares unfold_shared_weights(const Eigen::MatrixXd &X, const Eigen::MatrixXi &F,
+                                     const std::vector<SharingTarget> &targets, FapPartition &partition,
+                                     const std::function<int(size_t, const Eigen::VectorXd &)> &turned,
+                                     int threads) {
+  const Eigen::Index n = X.rows();
+  UnfoldedShares out;
+  out.turned_before.assign(targets.size(), 0);
+  out.turned_after.assign(targets.size(), 0);
+  std::vector<std::vector<int>> faces_of(static_cast<size_t>(n));
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    for (int j = 0; j < 3; ++j) faces_of[static_cast<size_t>(F(f, j))].push_back(static_cast<int>(f));
+  int components = 0;
+  for (int c : partition.component) components = std::max(components, c + 1);
+  const Eigen::VectorXd whole = Eigen::VectorXd::Ones(n);
+  Eigen::MatrixXd m = Eigen::MatrixXd::Zero(F.rows(), 3);
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    const Eigen::Vector3d xa = X.row(F(f, 0)).transpose(), xb = X.row(F(f, 1)).transpose(),
+                          xc = X.row(F(f, 2)).transpose();
+    const Eigen::Vector3d n0 = (xb - xa).cross(xc - xa);
+    if (n0.squaredNorm() > 0) m.row(f) = n0.transpose() / n0.squaredNorm();
+  }
+  for (int c = 0; c < components; ++c) {
+    // The set's FAPs, each with its targets (a FAP's sides share one weight).
+    std::vector<int> faps;
+    std::vector<std::vector<size_t>> of;
+    std::vector<char> fdp(static_cast<size_t>(n), 0);
+    for (size_t k = 0; k < targets.size(); ++k) {
+      if (partition.component[k] != c || partition.weight[k].size() != n) continue;
+      fdp[static_cast<size_t>(targets[k].vertex)] = 1;
+      const size_t i = static_cast<size_t>(std::find(faps.begin(), faps.end(), targets[k].fap) - faps.begin());
+      if (i == faps.size()) {
+        faps.push_back(targets[k].fap);
+        of.emplace_back();
+      }
+      of[i].push_back(k);
+    }
+    if (faps.size() < 2) continue;
+    std::vector<Eigen::VectorXd> w(faps.size());
+    for (size_t i = 0; i < faps.size(); ++i) w[i] = partition.weight[of[i][0]];
+
+    // The bounds: each target's triangles that its whole pose keeps facing.
+    struct Bound {
+      size_t fap;
+      const Eigen::MatrixXd *pose;
+      int face;
+    };
+    std::vector<Bound> bounds;
+    std::vector<std::vector<int>> bounds_of(static_cast<size_t>(F.rows()));
+    std::vector<int> active;  // bounds to visit in the next sweep, ascending
+    for (size_t i = 0; i < faps.size(); ++i)
+      for (size_t k : of[i]) {
+        const Eigen::MatrixXd *P = targets[k].displacement;
+        if (!P || P->rows() != n) continue;
+        for (Eigen::Index f = 0; f < F.rows(); ++f)
+          if (facing(X, F, m, whole, *P, f, nullptr) >= kUnfoldMargin) {
+            bounds_of[static_cast<size_t>(f)].push_back(static_cast<int>(bounds.size()));
+            if (facing(X, F, m, w[i], *P, f, nullptr) < kUnfoldMargin) active.push_back(static_cast<int>(bounds.size()));
+            bounds.push_back({i, P, static_cast<int>(f)});
+          }
+      }
+    // Only where a share turns a triangle its whole pose keeps.
+    const bool turns = std::any_of(active.begin(), active.end(), [&](int b) {
+      const Bound &r = bounds[static_cast<size_t>(b)];
+      return facing(X, F, m, w[r.fap], *r.pose, r.face, nullptr) < 0;
+    });
+    if (!turns) continue;
+    // The triangles a target's share turns before it is untangled (cheap):
+    // only targets that turn any, before or after, are judged as stored.
+    auto raw_turned = [&](size_t k, const Eigen::VectorXd &wk) {
+      const Eigen::MatrixXd *P = targets[k].displacement;
+      if (!P || P->rows() != n) return false;
+      for (Eigen::Index f = 0; f < F.rows(); ++f)
+        if (facing(X, F, m, wk, *P, f, nullptr) < 0) return true;
+      return false;
+    };
+    const std::vector<Eigen::VectorXd> start = w;
+
+    for (int sweep = 0; sweep < kUnfoldSweeps && !active.empty(); ++sweep) {
+      std::vector<char> changed(static_cast<size_t>(n), 0);
+      for (int b : active) {
+        const Bound &r = bounds[static_cast<size_t>(b)];
+        Eigen::Vector3d g;
+        const double h = facing(X, F, m, w[r.fap], *r.pose, r.face, &g);
+        if (h >= kUnfoldMargin) continue;
+        for (int j = 0; j < 3; ++j)
+          if (fdp[static_cast<size_t>(F(r.face, j))]) g(j) = 0;
+        const double gg = g.squaredNorm();
+        if (!(gg > 0)) continue;
+        const double step = (kUnfoldMargin - h) / gg;
+        for (int j = 0; j < 3; ++j) {
+          const int v = F(r.face, j);
+          if (g(j) == 0) continue;
+          double others = 0;
+          for (size_t o = 0; o < faps.size(); ++o)
+            if (o != r.fap) others += w[o](v);
+          if (!(others > 0)) continue;  // nothing to take the difference
+          const double d = std::clamp(step * g(j), -w[r.fap](v), others);
+          w[r.fap](v) += d;
+          const double scale = (others - d) / others;
+          for (size_t o = 0; o < faps.size(); ++o)
+            if (o != r.fap) w[o](v) *= scale;
+          changed[static_cast<size_t>(v)] = 1;
+        }
+      }
+      active.clear();
+      for (Eigen::Index v = 0; v < n; ++v)
+        if (changed[static_cast<size_t>(v)])
+          for (int f : faces_of[static_cast<size_t>(v)])
+            active.insert(active.end(), bounds_of[static_cast<size_t>(f)].begin(),
+                          bounds_of[static_cast<size_t>(f)].end());
+      std::sort(active.begin(), active.end());
+      active.erase(std::unique(active.begin(), active.end()), active.end());
+    }
+
+    // Each judged before and after, on the workers.
+    std::vector<std::pair<size_t, size_t>> judged;  // (fap, target)
+    for (size_t i = 0; i < faps.size(); ++i)
+      for (size_t k : of[i])
+        if (w[i] != start[i] && (raw_turned(k, start[i]) || raw_turned(k, w[i]))) judged.emplace_back(i, k);
+    std::vector<int> now(targets.size(), 0);
+    for_each_task(2 * judged.size(), threads, [&](size_t task) {
+      const auto [i, k] = judged[task / 2];
+      if (task % 2 == 0)
+        out.turned_before[k] = turned(k, start[i]);
+      else
+        now[k] = turned(k, w[i]);
+    });
+    int before = 0, after = 0;
+    for (const auto &[i, k] : judged) before += out.turned_before[k], after += now[k];
+    if (after >= before) {
+      for (size_t i = 0; i < faps.size(); ++i)
+        for (size_t k : of[i]) out.turned_after[k] = out.turned_before[k];
+      continue;
+    }
+    std::vector<char> moved(static_cast<size_t>(n), 0);
+    for (size_t i = 0; i < faps.size(); ++i) {
+      const Eigen::VectorXd &old = partition.weight[of[i][0]];
+      for (Eigen::Index v = 0; v < n; ++v)
+        if (w[i](v) != old(v)) {
+          moved[static_cast<size_t>(v)] = 1;
+          out.largest_change = std::max(out.largest_change, std::abs(w[i](v) - old(v)));
+        }
+      for (size_t k : of[i]) {
+        partition.weight[k] = w[i];
+        out.turned_after[k] = now[k];
+      }
+    }
+    out.vertices += static_cast<int>(std::count(moved.begin(), moved.end(), 1));
   }
   return out;
 }

@@ -54,9 +54,44 @@
 //
 // The eyelid FAPs (19-22) are left out: their targets already split
 // orbicularis oculi's pose between the two lids (fap_synthesis.cpp).
+//
+// Where a share turns the skin over, the set's weights are evened out
+// (unfold_shared_weights). Shepard's weights are flat at each FDP and fall
+// fastest halfway to the next: between two FDPs a distance L apart, with a
+// slope of 2 / L, twice the mean. Where a member's pose carries its FDP most
+// of the way to another member's FDP, which its share leaves in place, that
+// slope turns the skin between over. Song's FAP 57 raises 8.7 by 3.03 units
+// toward 2.8 (FAP 10's), which rests 3.35 above it, and its share turned 3
+// triangles halfway between; the untangling could not mend them, since
+// their patch grows to the FAP's own FDP, which keeps its motion
+// (untangle.h). The 10k head's 10 and 11 lowered and 57 and 58 raised
+// turned 1-2 each.
+//
+// The rule: the facing of a triangle (a, b, c) under a share w P, its normal
+// along the rest normal n0 over |n0|^2 (1 at rest, below 0 turned over),
+// with p = X + w P, is linear in each corner's weight:
+//
+//     d facing / d w_a = (P_a x (p_b - p_c)) . n0 / |n0|^2   (and cyclically).
+//
+// Each triangle that a member's whole pose keeps facing at least
+// kUnfoldMargin, and its share does not, is projected onto that bound: a
+// Kaczmarz step on the member's FAP's weights at the triangle's corners that
+// are no member's FDP (those keep their weights, so every FDP moves as
+// before). At each such corner the set's other FAPs take the difference in
+// proportion to their weights, so that the weights there add up as before
+// (the members at equal values still move every FDP by its own target's
+// motion). Sweeps go over the triangles around the corners the last sweep
+// changed, up to kUnfoldSweeps. A set none of whose shares turns a
+// triangle its pose keeps is left as it is; otherwise the evened weights
+// are kept when the shares, as they will be stored, turn fewer triangles
+// than before. Song: 57's and 58's 3 each -> 0, the weights changed at 23
+// vertices by 0.047 at most; the 10k head's six -> 0. Every frame of
+// ../shared/data's thirteen streams turns as many triangles as before
+// (afm-play --folds).
 #pragma once
 
 #include <Eigen/Core>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -77,7 +112,7 @@ struct SharingTarget {
   int vertex = -1;  // its FDP's vertex on the mesh the weights are for
   Eigen::Vector3d direction = Eigen::Vector3d::Zero();  // its FAP's positive direction
   int side = +1;                                        // its target's side of the FAP
-  const Eigen::MatrixXd *displacement = nullptr;        // #V x 3, its target (null: no overlap test)
+  const Eigen::MatrixXd *displacement = nullptr;        // #V x 3, its target (null: no overlap test, no unfolding)
   // The muscles of its group, each with the sign of its contraction (+1, -1).
   std::vector<std::pair<std::string, int>> muscles;
 };
@@ -92,5 +127,31 @@ struct FapPartition {
 // alone.
 FapPartition partition_shared_targets(const Eigen::MatrixXd &X, const Eigen::MatrixXi &F,
                                       const std::vector<SharingTarget> &targets);
+
+// The least facing the evening out asks of a share's triangle where the
+// whole pose keeps it (see above; 1 at rest). Song, in 50 sweeps: at 0.02
+// every bound met (in 36), at 0.05 all but one, at 0.1 all but 12, the
+// weights changed by up to 0.038, 0.047 and 0.072, and no share turned a
+// triangle; 0.05 leaves the slivers less thin than 0.02.
+constexpr double kUnfoldMargin = 0.05;
+constexpr int kUnfoldSweeps = 50;
+
+struct UnfoldedShares {
+  std::vector<int> turned_before;  // per target: triangles its share turned (0: not evened out or none)
+  std::vector<int> turned_after;   // per target: after (the same as before where the weights were kept)
+  int vertices = 0;                // vertices whose weights changed
+  double largest_change = 0;       // the largest change of a weight (0..1)
+};
+
+// Evens out `partition`'s weights where the shares turn skin over (see
+// above). X, F, targets: as given to partition_shared_targets; `turned(k,
+// w)`: how many triangles target k's share (its displacement times w, #V
+// weights) turns over as it will be stored, called from `threads` workers
+// (0: one per core; parallel.h) at once. Targets without a displacement or a
+// weight are left alone. The same result for any number of workers.
+UnfoldedShares unfold_shared_weights(const Eigen::MatrixXd &X, const Eigen::MatrixXi &F,
+                                     const std::vector<SharingTarget> &targets, FapPartition &partition,
+                                     const std::function<int(size_t, const Eigen::VectorXd &)> &turned,
+                                     int threads);
 
 }  // namespace afmb

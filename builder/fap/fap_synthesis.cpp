@@ -1383,7 +1383,29 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       sharing[k].side = work[k].side;
       sharing[k].displacement = &results[k].target->displacement[static_cast<size_t>(model.skin)];
     }
-    const FapPartition part = partition_shared_targets(skin.X0.topRows(skin.n), skin.F, sharing);
+    FapPartition part = partition_shared_targets(skin.X0.topRows(skin.n), skin.F, sharing);
+    // Where a share would turn skin over, the weights are evened out
+    // (fap_partition.h), judged as the target is stored: untangled (below).
+    const UnfoldedShares unfolded =
+        unfold_shared_weights(rest, skin.F, sharing, part, [&](size_t k, const Eigen::VectorXd &w) {
+          Eigen::MatrixXd D = results[k].target->displacement[static_cast<size_t>(model.skin)];
+          D.array().colwise() *= w.array();
+          untangle(rest, skin.F, target_hold(sharing[k].vertex), options.sim, D);
+          const SkinFaults f = face_faults(rest + D);
+          return static_cast<int>(f.turned_faces.size() + f.lifted_turned_faces.size());
+        }, options.threads);
+    for (size_t k = 0; k < work.size(); ++k)
+      if (unfolded.turned_after[k] < unfolded.turned_before[k]) {
+        char what[240];
+        std::snprintf(what, sizeof what,
+                      "its share of the skin it shares turned %d triangles (the lifted skin's counted too), %d "
+                      "once the shares were evened out (weights changed by up to %.2g at %d vertices: "
+                      "fap_partition.h)",
+                      unfolded.turned_before[k], unfolded.turned_after[k], unfolded.largest_change,
+                      unfolded.vertices);
+        FapOutcome &o = results[k].outcome;
+        o.message += std::string(o.message.empty() ? "" : "; ") + what;
+      }
     skin_share = part.weight;
     const size_t sk = static_cast<size_t>(model.skin);
     for (size_t k = 0; k < work.size(); ++k) {

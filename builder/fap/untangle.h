@@ -32,11 +32,11 @@
 // that changes it by at most kSliverShare of the edge, it is not fixed (a
 // held one may move: Song's lids at their corners, 0.09-0.18 units, which
 // takes them further off the eyeball), and fewer triangles turn after. What
-// still turns stays turned, for the caller to report: the folds at the lower
-// lip's FDPs that the split of shared skin makes (fap_partition.h), where a
-// FAP alone carries its FDP most of the way to the other lip line's (Song's
-// FAP 57 raises 8.7 3.03 units toward 2.8, which rests 3.35 above it and
-// stays).
+// still turns stays turned, for the caller to report (the lower lip's
+// in-betweens at -1024, carried most of the way to the chin). The folds
+// that the split of shared skin made next to a FAP's own FDP (Song's FAP 57
+// raises 8.7 3.03 units toward 2.8, which rests 3.35 above it and stays)
+// are evened out in the split's weights before (fap_partition.h).
 //
 // On a simulation mesh (`sim` decimated), what is stored is the lifted
 // skin (sim_mesh.h), so its turned triangles count too: each stands for

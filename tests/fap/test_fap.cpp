@@ -2009,6 +2009,75 @@ TEST(FapPartition, OverlappingTargetsLinkAndDistancesRunAlongTheMesh) {
   EXPECT_EQ(straight.weight[0](1), 0.5);
 }
 
+// Where a share turns the skin over, the weights are evened out
+// (unfold_shared_weights, fap_partition.h). A strip 4 units long, an FDP at
+// each end, both FAPs' poses carrying the whole strip 3.6 units up (as
+// Song's FAP 57 carries 8.7 3.03 units toward 2.8, 3.35 above): Shepard's
+// weights fall with twice the mean slope halfway, so the lower FAP's share
+// turns the middle over; a linear fall would keep it (facing 0.1). After
+// the evening out neither share turns a triangle, every FDP keeps its
+// weights, and at every vertex the weights add up as before.
+TEST(FapPartition, WeightsAreEvenedOutWhereAShareTurnsTheSkinOver) {
+  const int rows = 9, cols = 3;
+  Eigen::MatrixXd X(rows * cols, 3);
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) X.row(r * cols + c) << c - 1, 0.5 * r, 0;
+  Eigen::MatrixXi F(2 * (rows - 1) * (cols - 1), 3);
+  int f = 0;
+  for (int r = 0; r + 1 < rows; ++r)
+    for (int c = 0; c + 1 < cols; ++c) {
+      const int a = r * cols + c, b = a + 1, d = a + cols, e = d + 1;
+      F.row(f++) << a, b, e;  // counter-clockwise: facing +z
+      F.row(f++) << a, e, d;
+    }
+  const int low = 1, high = (rows - 1) * cols + 1;  // the ends' middles
+  Eigen::MatrixXd P = Eigen::MatrixXd::Zero(X.rows(), 3);
+  P.col(1).setConstant(3.6);
+  std::vector<SharingTarget> t = {sharing(57, low, Eigen::Vector3d::UnitY(), {{"m", +1}}),
+                                  sharing(10, high, Eigen::Vector3d::UnitY(), {{"m", +1}})};
+  t[0].displacement = t[1].displacement = &P;
+  FapPartition p = partition_shared_targets(X, F, t);
+  ASSERT_EQ(p.component[0], p.component[1]);
+  // Turned: the normal under the share against the rest one (+z).
+  auto turned = [&](size_t, const Eigen::VectorXd &w) {
+    int n = 0;
+    for (Eigen::Index g = 0; g < F.rows(); ++g) {
+      Eigen::Vector3d q[3];
+      for (int j = 0; j < 3; ++j) q[j] = (X.row(F(g, j)) + w(F(g, j)) * P.row(F(g, j))).transpose();
+      n += (q[1] - q[0]).cross(q[2] - q[0]).z() <= 0;
+    }
+    return n;
+  };
+  const FapPartition shepard = p;
+  ASSERT_GT(turned(0, shepard.weight[0]), 0) << "the scene does not fold: the test tests nothing";
+  const UnfoldedShares u = unfold_shared_weights(X, F, t, p, turned, 1);
+  EXPECT_GT(u.turned_before[0], 0);
+  EXPECT_EQ(u.turned_after[0], 0);
+  EXPECT_EQ(u.turned_after[1], 0);
+  for (size_t k = 0; k < 2; ++k) EXPECT_EQ(turned(k, p.weight[k]), 0) << k;
+  EXPECT_GT(u.vertices, 0);
+  EXPECT_GT(u.largest_change, 0);
+  EXPECT_LE(u.largest_change, 1);
+  for (size_t k = 0; k < 2; ++k)
+    for (int v : {low, high}) EXPECT_EQ(p.weight[k](v), shepard.weight[k](v)) << k << " at FDP " << v;
+  for (Eigen::Index v = 0; v < X.rows(); ++v) {
+    EXPECT_NEAR(p.weight[0](v) + p.weight[1](v), shepard.weight[0](v) + shepard.weight[1](v), 1e-12) << v;
+    EXPECT_GE(p.weight[0](v), 0) << v;
+    EXPECT_GE(p.weight[1](v), 0) << v;
+  }
+  // The same on two workers.
+  FapPartition q = partition_shared_targets(X, F, t);
+  unfold_shared_weights(X, F, t, q, turned, 2);
+  for (size_t k = 0; k < 2; ++k) EXPECT_EQ(q.weight[k], p.weight[k]) << k;
+  // A share that turns nothing is left alone.
+  P.col(1).setConstant(1.0);
+  FapPartition calm = partition_shared_targets(X, F, t);
+  const FapPartition calm0 = calm;
+  const UnfoldedShares none = unfold_shared_weights(X, F, t, calm, turned, 1);
+  EXPECT_EQ(none.vertices, 0);
+  for (size_t k = 0; k < 2; ++k) EXPECT_EQ(calm.weight[k], calm0.weight[k]) << k;
+}
+
 // Real streams send the inner and outer lip FAPs together at equal values.
 // FAPs 12 and 59 (the inner and outer corner raised) are both zygomaticus
 // major left: put 59's FDP 8.3 on another vertex of the upper lip (on the
@@ -2483,7 +2552,8 @@ TEST(FapSynthesis, SongsInnerBrowComesDownMostOfItsReferenceWithoutAFold) {
 // pushes it (fap_mapping.cpp). Made with the lower lip's other outer FAPs,
 // it reaches the reference, -350, as in the whole AFM, and folds none of
 // the lifted skin (the whole AFM's positive side, which splits its skin
-// with the inner lip's FAPs too, turns 3 triangles: README, "Open").
+// with the inner lip's FAPs too, turned 3 triangles until the split's
+// weights were evened out: fap_partition.h).
 // Mentalis alone reached 61 % here and held it to the reference (62 %;
 // docs/anatomy.md, "Depressor labii inferioris").
 TEST(FapSynthesis, SongsLowerLipComesDownToItsReferenceWithoutAFold) {
