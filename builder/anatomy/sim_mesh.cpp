@@ -133,6 +133,11 @@ class MirroredDecimater : public OpenMesh::Decimater::BaseDecimaterT<TriMesh> {
   using Base = OpenMesh::Decimater::BaseDecimaterT<TriMesh>;
   MirroredDecimater(TriMesh &mesh, std::vector<int> mirror) : Base(mesh), mesh_(mesh), mirror_(std::move(mirror)) {}
 
+  // The priority module (the one that is not binary), whose priority
+  // orders a vertex's candidates before their legality is checked (heap()).
+  // Needed before decimate_to().
+  void set_order(OpenMesh::Decimater::ModBaseT<TriMesh> *order) { order_ = order; }
+
   // Collapses until at most `target` vertices are left (one fewer where the
   // last collapse's image follows it) or no collapse is legal. Returns the
   // collapses made; *unpaired gets those whose image could not follow.
@@ -229,22 +234,27 @@ class MirroredDecimater : public OpenMesh::Decimater::BaseDecimaterT<TriMesh> {
     this->postprocess_collapse(ci);
   }
 
-  // v's best legal collapse, queued (or none). The image is checked in
-  // order of priority, until one passes: the image's check costs as much as
-  // the collapse's own.
+  // v's best legal collapse, queued (or none). The candidates go in order
+  // of the priority module's priority, which is the decimater's where the
+  // binary modules pass, until one is legal alone and with its image: the
+  // legality checks cost several times the priority (callgrind on Song's
+  // decimation: 1.15 -> 0.84 billion instructions, checking every
+  // candidate's legality first; the same collapses).
   void heap(TriMesh::VertexHandle v) {
     const size_t i = static_cast<size_t>(v.idx());
-    std::vector<std::pair<float, int>> alone;  // priority, halfedge index
-    for (TriMesh::HalfedgeHandle h : mesh_.voh_range(v)) {
-      float p = 0;
-      if (legal_alone(h, &p)) alone.emplace_back(p, h.idx());
-    }
-    std::sort(alone.begin(), alone.end());
+    std::vector<std::pair<float, int>> order;  // priority, halfedge index
+    if (!mesh_.status(v).locked())  // is_collapse_legal's first test
+      for (TriMesh::HalfedgeHandle h : mesh_.voh_range(v)) {
+        const float p = order_->collapse_priority(CollapseInfo(mesh_, h));
+        if (p >= 0) order.emplace_back(p, h.idx());
+      }
+    std::sort(order.begin(), order.end());
     TriMesh::HalfedgeHandle target;
     float best = 0;
-    for (const auto &[p, h] : alone) {
+    for (const auto &[p, h] : order) {
+      float q = 0;
       TriMesh::HalfedgeHandle image;
-      if (pair_legal(TriMesh::HalfedgeHandle(h), &image)) {
+      if (legal_alone(TriMesh::HalfedgeHandle(h), &q) && q == p && pair_legal(TriMesh::HalfedgeHandle(h), &image)) {
         best = p, target = TriMesh::HalfedgeHandle(h);
         break;
       }
@@ -259,6 +269,7 @@ class MirroredDecimater : public OpenMesh::Decimater::BaseDecimaterT<TriMesh> {
   std::vector<TriMesh::HalfedgeHandle> best_;
   std::vector<unsigned> stamp_;
   std::priority_queue<Entry> queue_;
+  OpenMesh::Decimater::ModBaseT<TriMesh> *order_ = nullptr;
 };
 
 // For every skin vertex, the kept vertex nearest along the skin's edges
@@ -488,6 +499,7 @@ Expected<SimMesh> make_sim_mesh(const Scene &scene, const FdpSet &fdps, const Si
   dec.module(aspect).set_aspect_ratio(kMaxAspectRatio);
   dec.module(aspect).set_binary(true);
   if (!dec.initialize()) return identity();
+  dec.set_order(&dec.module(length));
   size_t unpaired = 0;
   dec.decimate_to(static_cast<size_t>(options.vertices), &unpaired);
 
