@@ -712,22 +712,37 @@ Eigen::Vector3d face_normal(const Eigen::MatrixXd &X, const Eigen::MatrixXi &F, 
 
 }  // namespace
 
-std::vector<int> turned_faces(const Eigen::MatrixXd &V0, const Eigen::MatrixXi &F, const Eigen::MatrixXd &V,
+RestFaces rest_faces(const Eigen::MatrixXd &V0, const Eigen::MatrixXi &F) {
+  RestFaces r;
+  r.normal.resize(static_cast<size_t>(F.rows()));
+  r.length.resize(F.rows());
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    const Eigen::Vector3d n = face_normal(V0, F, f);
+    r.normal[static_cast<size_t>(f)] = n;
+    r.length(f) = n.norm();
+    r.total += r.length(f);
+  }
+  return r;
+}
+
+std::vector<int> turned_faces(const RestFaces &rest, const Eigen::MatrixXi &F, const Eigen::MatrixXd &V,
                               double *share) {
-  double total = 0;
-  for (Eigen::Index f = 0; f < F.rows(); ++f) total += face_normal(V0, F, f).norm();
-  const double mean = total / std::max<double>(1, static_cast<double>(F.rows()));
+  const double mean = rest.total / std::max<double>(1, static_cast<double>(F.rows()));
   std::vector<int> out;
   double turned = 0;
   for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    const Eigen::Vector3d n0 = face_normal(V0, F, f);
-    if (n0.norm() > 1e-3 * mean && n0.dot(face_normal(V, F, f)) <= 0) {
+    if (rest.length(f) > 1e-3 * mean && rest.normal[static_cast<size_t>(f)].dot(face_normal(V, F, f)) <= 0) {
       out.push_back(static_cast<int>(f));
-      turned += n0.norm();
+      turned += rest.length(f);
     }
   }
-  if (share) *share = total > 0 ? turned / total : 0;
+  if (share) *share = rest.total > 0 ? turned / rest.total : 0;
   return out;
+}
+
+std::vector<int> turned_faces(const Eigen::MatrixXd &V0, const Eigen::MatrixXi &F, const Eigen::MatrixXd &V,
+                              double *share) {
+  return turned_faces(rest_faces(V0, F), F, V, share);
 }
 
 SkinFaults skin_faults(const FaceModel &model, const Eigen::MatrixXd &E) {

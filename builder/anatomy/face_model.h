@@ -265,6 +265,17 @@ SkinFaults skin_faults(const FaceModel &model, const Eigen::MatrixXd &E);
 std::vector<int> turned_faces(const Eigen::MatrixXd &V0, const Eigen::MatrixXi &F, const Eigen::MatrixXd &V,
                               double *share = nullptr);
 
+// The same with the rest triangles' normals computed once (rest_faces), for
+// a mesh checked many times: the same result.
+struct RestFaces {
+  std::vector<Eigen::Vector3d> normal;  // #F: each rest triangle's normal, twice its area long
+  Eigen::VectorXd length;  // #F: those lengths
+  double total = 0;        // their sum
+};
+RestFaces rest_faces(const Eigen::MatrixXd &V0, const Eigen::MatrixXi &F);
+std::vector<int> turned_faces(const RestFaces &rest, const Eigen::MatrixXi &F, const Eigen::MatrixXd &V,
+                              double *share = nullptr);
+
 // The signed tension of muscle i at `percent` contraction.
 double muscle_tension(const Muscle &m, double percent);
 

@@ -397,6 +397,7 @@ Expected<SimMesh> make_sim_mesh(const Scene &scene, const FdpSet &fdps, const Si
     sim.binding = bind_fine_to_coarse(skin, sim);
     sim.skin_V = skin.V;
     sim.skin_F = skin.F;
+    sim.skin_rest = rest_faces(sim.skin_V, sim.skin_F);
     sim.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return sim;
   };
@@ -540,6 +541,7 @@ Expected<SimMesh> make_sim_mesh(const Scene &scene, const FdpSet &fdps, const Si
   sim.binding = bind_fine_to_coarse(skin, sim);
   sim.skin_V = skin.V;
   sim.skin_F = skin.F;
+  sim.skin_rest = rest_faces(sim.skin_V, sim.skin_F);
   sim.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return sim;
 }
@@ -644,7 +646,10 @@ Eigen::MatrixXd lift_displacement(const SimMesh &sim, const Eigen::MatrixXd &Dc)
 }
 
 std::vector<int> lifted_turned_faces(const SimMesh &sim, const Eigen::MatrixXd &Dc, double *share) {
-  return turned_faces(sim.skin_V, sim.skin_F, sim.skin_V + lift_displacement(sim, Dc), share);
+  Eigen::MatrixXd V = lift_displacement(sim, Dc);
+  V += sim.skin_V;
+  if (sim.skin_rest.length.size() != sim.skin_F.rows()) return turned_faces(sim.skin_V, sim.skin_F, V, share);
+  return turned_faces(sim.skin_rest, sim.skin_F, V, share);
 }
 
 }  // namespace afmb

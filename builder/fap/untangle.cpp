@@ -12,8 +12,9 @@ Untangled untangle(const Eigen::MatrixXd &V0, const Eigen::MatrixXi &F, const st
                    const SimMesh *sim, Eigen::MatrixXd &D) {
   const bool lifted = sim && sim->decimated;
   std::vector<int> coarse, fine;  // the turned triangles of the last count
+  const RestFaces rest = rest_faces(V0, F);
   auto count = [&](const Eigen::MatrixXd &E) {
-    coarse = turned_faces(V0, F, V0 + E);
+    coarse = turned_faces(rest, F, V0 + E);
     fine = lifted ? lifted_turned_faces(*sim, E) : std::vector<int>();
     return static_cast<int>(coarse.size() + fine.size());
   };
