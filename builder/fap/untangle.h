@@ -34,9 +34,10 @@
 // takes them further off the eyeball), and fewer triangles turn after. What
 // still turns stays turned, for the caller to report (the lower lip's
 // in-betweens at -1024, carried most of the way to the chin). The folds
-// that the split of shared skin made next to a FAP's own FDP (Song's FAP 57
-// raises 8.7 3.03 units toward 2.8, which rests 3.35 above it and stays)
-// are evened out in the split's weights before (fap_partition.h).
+// that the split of shared skin made between a FAP's FDP and another FAP's
+// (Song's FAP 57 raises 8.7 3.03 units toward 2.8, which rests 3.35 above
+// it and stays) are evened out in the split's weights before
+// (fap_partition.h).
 //
 // On a simulation mesh (`sim` decimated), what is stored is the lifted
 // skin (sim_mesh.h), so its turned triangles count too: each stands for
