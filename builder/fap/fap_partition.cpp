@@ -5,6 +5,7 @@
 #include <limits>
 #include <numeric>
 
+#include "anatomy/face_model.h"
 #include "core/edge_paths.h"
 #include "core/parallel.h"
 
@@ -149,13 +150,11 @@ UnfoldedShares unfold_shared_weights(const Eigen::MatrixXd &X, const Eigen::Matr
   int components = 0;
   for (int c : partition.component) components = std::max(components, c + 1);
   const Eigen::VectorXd whole = Eigen::VectorXd::Ones(n);
+  const RestFaces rest = rest_faces(X, F);
   Eigen::MatrixXd m = Eigen::MatrixXd::Zero(F.rows(), 3);
-  for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    const Eigen::Vector3d xa = X.row(F(f, 0)).transpose(), xb = X.row(F(f, 1)).transpose(),
-                          xc = X.row(F(f, 2)).transpose();
-    const Eigen::Vector3d n0 = (xb - xa).cross(xc - xa);
-    if (n0.squaredNorm() > 0) m.row(f) = n0.transpose() / n0.squaredNorm();
-  }
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    if (const Eigen::Vector3d &n0 = rest.normal[static_cast<size_t>(f)]; n0.squaredNorm() > 0)
+      m.row(f) = n0.transpose() / n0.squaredNorm();
   for (int c = 0; c < components; ++c) {
     // The set's FAPs, each with its targets (a FAP's sides share one weight).
     std::vector<int> faps;
