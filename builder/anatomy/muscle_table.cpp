@@ -87,6 +87,16 @@ const std::vector<MuscleDef> kTable = {
     // paper's nasalis (9.7 -> 9.1) moves the wing back and up.
     {"dilator_naris_left", K::Linear, "1/2 (9.1 + 9.2)", "9.1", nullptr, 0.30, -1, 0.20, 0.10, false, false, false, L::Key, nullptr, nullptr, true},
     {"dilator_naris_right", K::Linear, "1/2 (9.1 + 9.2)", "9.2", nullptr, 0.30, -1, 0.20, 0.10, false, false, false, L::Key, nullptr, nullptr, true},
+    // The cheek puffed out (not in the paper; docs/anatomy.md "Cheek puff"):
+    // air pressure in the mouth, no muscle, which MPEG-4's puff_l_cheek and
+    // puff_r_cheek (FAPs 39, 40) ask for. A push from the mouth's middle,
+    // halfway between the cheeks (5.1, 5.2), out through the cheek's whole
+    // thickness: nearly along the skin's normal, as a pressure pushes.
+    // +100 % takes the cheek a quarter of that half-width out, -100 % (the
+    // cheek sucked in) a quarter in: with 10 % in, Song's sucked cheek
+    // needed 2.2 times its range and turned 30 triangles.
+    {"cheek_puff_left", K::Linear, "1/2 (5.1 + 5.2)", "5.1", nullptr, 0.45, -1, 0.25, 0.25, false, false, false, L::Key, nullptr, nullptr, true},
+    {"cheek_puff_right", K::Linear, "1/2 (5.1 + 5.2)", "5.2", nullptr, 0.45, -1, 0.25, 0.25, false, false, false, L::Key, nullptr, nullptr, true},
     // The chin raised (not in the paper; docs/anatomy.md "Chin raiser"):
     // mentalis' own pull on the chin's skin (FACS AU 17), which the table's
     // mentalis, driven as a push on the lower lip, leaves out. A fibre along

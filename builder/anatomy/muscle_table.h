@@ -2,10 +2,12 @@
 // drivers this project adds: four for the lids (the palpebral part of
 // orbicularis oculi, one per lid: docs/anatomy.md "The lids"), two that
 // push the lips out (docs/anatomy.md "Lip protrusion"), two that flare
-// the nose's wings (docs/anatomy.md "Nostril dilators"), one that raises
-// the chin (docs/anatomy.md "Chin raiser"), two that lower the inner
-// brows (docs/anatomy.md "Depressor supercilii") and two that lower the
-// lower lip (docs/anatomy.md "Depressor labii inferioris").
+// the nose's wings (docs/anatomy.md "Nostril dilators"), two that puff
+// the cheeks out (air pressure in the mouth: docs/anatomy.md "Cheek
+// puff"), one that raises the chin (docs/anatomy.md "Chin raiser"), two
+// that lower the inner brows (docs/anatomy.md "Depressor supercilii") and
+// two that lower the lower lip (docs/anatomy.md "Depressor labii
+// inferioris").
 //
 // Key points are written as in the paper, affine combinations of FDP
 // positions: "11.1 + 1/6 (11.3 - 11.1)". parse_keypoint() turns one into
@@ -83,7 +85,8 @@ struct MuscleDef {
   // Linear: its line of action (PullLine): Surface for the muscles along the
   // bone (frontalis, corrugator, zygomaticus major, risorius, depressor
   // anguli, the chin raiser, depressor supercilii), Key for the pushes
-  // (mentalis, the lip protrusion drivers, the nostril dilators) and
+  // (mentalis, the lip protrusion drivers, the nostril dilators, the cheek
+  // puffs) and
   // depressor labii's pull, Skull for the others (nasalis, upper lip,
   // zygomaticus minor). Others: Skull (unused).
   PullLine line;
@@ -93,7 +96,8 @@ struct MuscleDef {
   // Linear: the load acts on each influence vertex's epidermal, dermal and
   // hypodermal nodes, a third each, instead of the dermal node alone: a
   // muscle inside the tissue it moves (the lip protrusion drivers: the lip's
-  // own orbicularis; the nostril dilators: the wing's), not under it.
+  // own orbicularis; the nostril dilators: the wing's; the cheek puffs:
+  // the air's pressure on the cheek from inside), not under it.
   // Pushed by its dermis alone, the upper lip's dermis passed through its
   // epidermis (docs/anatomy.md).
   bool whole_thickness = false;
@@ -102,8 +106,8 @@ struct MuscleDef {
 // The 25 muscles, in the paper's order (Table 1 top to bottom, left before
 // right, then Table 2), then the four lid drivers (upper left, upper right,
 // lower left, lower right), then the two lip protrusion drivers (upper,
-// lower) and the two nostril dilators (left, right): linear muscles that
-// push; last the chin raiser and the two depressores supercilii (left,
+// lower), the two nostril dilators (left, right) and the two cheek puffs
+// (left, right): linear muscles that push; last the chin raiser and the two depressores supercilii (left,
 // right), linear muscles that pull.
 const std::vector<MuscleDef> &muscle_table();
 // "linear", "sphincter", "lid".

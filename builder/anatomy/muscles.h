@@ -47,8 +47,9 @@
 // +-100 % move it a fraction of the opening |a - b|.
 //
 // A linear muscle with MuscleDef::whole_thickness (the lip protrusion
-// drivers, the nostril dilators) loads the vertex's epidermal, dermal and
-// hypodermal nodes with a third of w each instead of its dermal node.
+// drivers, the nostril dilators, the cheek puffs) loads the vertex's
+// epidermal, dermal and hypodermal nodes with a third of w each instead of
+// its dermal node.
 //
 // Force on a node: sense x t x w x direction, where t is the signed tension
 // (model force per unit area; positive: the muscle's action, negative: the

@@ -185,8 +185,8 @@ int penetrating_nodes(const SkinModel &s, const Eigen::MatrixXd &X, double slack
 
 TEST(MuscleTable, TwentyFiveMusclesWithParsableKeyPoints) {
   const auto &t = muscle_table();
-  ASSERT_EQ(t.size(), 38u) << "the paper's 25, four lid drivers, two lip protrusion drivers, two nostril dilators, "
-                               "the chin raiser, two depressores supercilii, two depressores labii";
+  ASSERT_EQ(t.size(), 40u) << "the paper's 25, four lid drivers, two lip protrusion drivers, two nostril dilators, "
+                               "two cheek puffs, the chin raiser, two depressores supercilii, two depressores labii";
   // The last rows: mentalis' pull on the chin's skin and the inner brows'
   // depressors, linear muscles that pull along the bone, then the lower
   // lip's depressors, which pull toward their attachment on the chin's skin.
@@ -215,14 +215,16 @@ TEST(MuscleTable, TwentyFiveMusclesWithParsableKeyPoints) {
       EXPECT_EQ(d.line, p.line) << name;
       EXPECT_STREQ(d.insertion_or_minor, p.insertion) << name;
     } else if (!paper && !lid) {
-      // The lip protrusion drivers and the nostril dilators: linear muscles
-      // that push (like mentalis) from a key point, on the tissue's whole
-      // thickness.
+      // The lip protrusion drivers, the nostril dilators and the cheek
+      // puffs: linear muscles that push (like mentalis) from a key point, on
+      // the tissue's whole thickness.
       EXPECT_EQ(d.kind, MuscleKind::Linear) << name;
       EXPECT_EQ(d.sense, -1) << name;
       EXPECT_EQ(d.line, PullLine::Key) << name;
       EXPECT_TRUE(d.whole_thickness) << name;
-      EXPECT_TRUE(name.rfind("lip_protrusion_", 0) == 0 || name.rfind("dilator_naris_", 0) == 0) << name;
+      EXPECT_TRUE(name.rfind("lip_protrusion_", 0) == 0 || name.rfind("dilator_naris_", 0) == 0 ||
+                  name.rfind("cheek_puff_", 0) == 0)
+          << name;
     }
     if (paper) (d.kind == MuscleKind::Linear ? linear : sphincter)++;
     for (const char *text : {d.attachment_or_major, d.insertion_or_minor, d.epicentre, d.corner_outer, d.corner_inner}) {
@@ -735,6 +737,36 @@ TEST(Physics, EachMuscleMovesItsRegionTheWayAnatomySays) {
     EXPECT_LT(std::abs(d.y()), 0.5 * d.x()) << "out more than up or down";
     EXPECT_LT(o.norm(), 0.2 * d.x()) << "the right wing stays";
     EXPECT_EQ(inverted_elements(m.tissue, X), 0);
+  }
+  // The left cheek puff (air pressure in the mouth) bulges the left cheek
+  // out through its surface, and -100 % draws it in: the cheek's FDP (5.1)
+  // goes out (+x) or in, more sideways than up or down, its area moves
+  // along its rest normals, out or in, the other cheek (5.2) and the mouth's
+  // middle (8.1, 8.2) stay, and sucked in, no node goes into the skull
+  // (docs/anatomy.md, "Cheek puff").
+  for (const double sign : {+1.0, -1.0}) {
+    const char *name = "cheek_puff_left";
+    const Eigen::MatrixXd X = contract(m, name, sign * t);
+    const Eigen::Vector3d d = moved(m, X, "5.1"), o = moved(m, X, "5.2");
+    const Muscle &mu = m.muscles[static_cast<size_t>(m.find(name))];
+    double along = 0, total = 0;  // the influence area's motion along its rest normals, and its length
+    for (int v : mu.influence) {
+      const Eigen::Vector3d u = X.row(v) - m.tissue.X0.row(v);
+      along += u.dot(m.tissue.normal.row(v));
+      total += u.norm();
+    }
+    const double lips = std::max(moved(m, X, "8.1").norm(), moved(m, X, "8.2").norm());
+    std::printf("%s %+.0f: 5.1 sideways %.3f mm, up %.3f mm, forward %.3f mm; along the normals %.2f of its "
+                "area's motion; 5.2 moves %.3f mm, the lips' middles %.3f mm\n",
+                name, sign, mm(d.x()), mm(d.y()), mm(d.z()), along / total, mm(o.norm()), mm(lips));
+    EXPECT_GT(sign * d.x(), 0.1e-3) << name << " moves the cheek out (+x) at +, in at -";
+    EXPECT_LT(std::abs(d.y()), 0.5 * std::abs(d.x())) << name << " sideways more than up or down";
+    EXPECT_GT(sign * along, 0.5 * total) << name << " moves its area along its rest normals";
+    EXPECT_LT(o.norm(), 0.1 * std::abs(d.x())) << name << ": the right cheek stays";
+    EXPECT_LT(lips, 0.3 * std::abs(d.x())) << name << ": the lips' middles stay";
+    EXPECT_EQ(inverted_elements(m.tissue, X), 0) << name;
+    EXPECT_EQ(penetrating_nodes(m.tissue, X, 1e-9), 0) << name;
+    EXPECT_TRUE(X.allFinite()) << name;
   }
   {
     const Eigen::MatrixXd X = contract(m, "orbicularis_oculi_left", t);
