@@ -92,11 +92,12 @@ const std::vector<MuscleDef> kTable = {
     // puff_r_cheek (FAPs 39, 40) ask for. A push from the mouth's middle,
     // halfway between the cheeks (5.1, 5.2), out through the cheek's whole
     // thickness: nearly along the skin's normal, as a pressure pushes.
-    // +100 % takes the cheek a quarter of that half-width out, -100 % (the
-    // cheek sucked in) a quarter in: with 10 % in, Song's sucked cheek
-    // needed 2.2 times its range and turned 30 triangles.
-    {"cheek_puff_left", K::Linear, "1/2 (5.1 + 5.2)", "5.1", nullptr, 0.45, -1, 0.25, 0.25, false, false, false, L::Key, nullptr, nullptr, true},
-    {"cheek_puff_right", K::Linear, "1/2 (5.1 + 5.2)", "5.2", nullptr, 0.45, -1, 0.25, 0.25, false, false, false, L::Key, nullptr, nullptr, true},
+    // +100 % takes the cheek 15 % of that half-width out, -100 % (the cheek
+    // sucked in) 11 % in: at a quarter in, the cheek's tissue was crushed
+    // on the skull behind it (3 slabs turned on the 1k head, even with the
+    // collapse floor).
+    {"cheek_puff_left", K::Linear, "1/2 (5.1 + 5.2)", "5.1", nullptr, 0.45, -1, 0.15, 0.11, false, false, false, L::Key, nullptr, nullptr, true},
+    {"cheek_puff_right", K::Linear, "1/2 (5.1 + 5.2)", "5.2", nullptr, 0.45, -1, 0.15, 0.11, false, false, false, L::Key, nullptr, nullptr, true},
     // The chin raised (not in the paper; docs/anatomy.md "Chin raiser"):
     // mentalis' own pull on the chin's skin (FACS AU 17), which the table's
     // mentalis, driven as a push on the lower lip, leaves out. A fibre along
