@@ -89,15 +89,16 @@ const std::vector<MuscleDef> kTable = {
     {"dilator_naris_right", K::Linear, "1/2 (9.1 + 9.2)", "9.2", nullptr, 0.30, -1, 0.20, 0.10, false, false, false, L::Key, nullptr, nullptr, true},
     // The cheek puffed out (not in the paper; docs/anatomy.md "Cheek puff"):
     // air pressure in the mouth, no muscle, which MPEG-4's puff_l_cheek and
-    // puff_r_cheek (FAPs 39, 40) ask for. A push from the mouth's middle,
-    // halfway between the cheeks (5.1, 5.2), out through the cheek's whole
-    // thickness: nearly along the skin's normal, as a pressure pushes.
-    // +100 % takes the cheek 15 % of that half-width out, -100 % (the cheek
-    // sucked in) 11 % in: at a quarter in, the cheek's tissue was crushed
-    // on the skull behind it (3 slabs turned on the 1k head, even with the
-    // collapse floor).
-    {"cheek_puff_left", K::Linear, "1/2 (5.1 + 5.2)", "5.1", nullptr, 0.45, -1, 0.15, 0.11, false, false, false, L::Key, nullptr, nullptr, true},
-    {"cheek_puff_right", K::Linear, "1/2 (5.1 + 5.2)", "5.2", nullptr, 0.45, -1, 0.15, 0.11, false, false, false, L::Key, nullptr, nullptr, true},
+    // puff_r_cheek (FAPs 39, 40) ask for. A push through the cheek's FDP
+    // (5.1, 5.2) from half the mouth's width inside it, along the corners'
+    // offset (x on a level mouth), and through the cheek's whole thickness:
+    // nearly along the skin's normal, as a pressure pushes. +100 % takes the
+    // cheek 20 % of the fibre out, -100 % (sucked in) 16 % in: the skull
+    // stands behind the cheek, and a quarter of the cheeks' half-distance
+    // in crushed the tissue on it (3 slabs turned on the 1k head, even with
+    // the collapse floor).
+    {"cheek_puff_left", K::Linear, "5.1 + 1/2 (8.4 - 8.3)", "5.1", nullptr, 0.60, -1, 0.20, 0.16, false, false, false, L::Key, nullptr, nullptr, true},
+    {"cheek_puff_right", K::Linear, "5.2 + 1/2 (8.3 - 8.4)", "5.2", nullptr, 0.60, -1, 0.20, 0.16, false, false, false, L::Key, nullptr, nullptr, true},
     // The chin raised (not in the paper; docs/anatomy.md "Chin raiser"):
     // mentalis' own pull on the chin's skin (FACS AU 17), which the table's
     // mentalis, driven as a push on the lower lip, leaves out. A fibre along

@@ -53,7 +53,9 @@
 // (once for the nose tip, twice for the corners).
 //
 // The eyelid FAPs (19-22) are left out: their targets already split
-// orbicularis oculi's pose between the two lids (fap_synthesis.cpp).
+// orbicularis oculi's pose between the two lids (fap_synthesis.cpp). So are
+// the cheek puffs (39, 40), air pressure that streams do not send with the
+// FAPs around the cheek (FapMapping::own_skin).
 //
 // Where a share turns the skin over, the set's weights are evened out
 // (unfold_shared_weights). Shepard's weights are flat at each FDP and fall

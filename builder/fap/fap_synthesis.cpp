@@ -1369,9 +1369,10 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     std::vector<SharingTarget> sharing(work.size());
     for (size_t k = 0; k < work.size(); ++k) {
       const FapMapping *f = work[k].fap;
-      // Lids share no skin. An in-between is a FAP's own target past its
-      // reference: it takes no share apart from the FAP's.
-      if (!f || f->driver != FapDriver::Muscles || f->lid || work[k].in_between || !results[k].target) continue;
+      // Lids and the cheek puffs share no skin. An in-between is a FAP's own
+      // target past its reference: it takes no share apart from the FAP's.
+      if (!f || f->driver != FapDriver::Muscles || f->lid || f->own_skin || work[k].in_between || !results[k].target)
+        continue;
       const afm_fap_info *info = afm_fap(f->fap);
       const int fdp = fdp_vertex(model, info);
       if (fdp < 0) continue;

@@ -503,11 +503,19 @@ TEST(SimMesh, SongsMusclesAttachAsOnTheSkinAndAlikeOnBothSides) {
     const int ri = m.find(l.name.substr(0, side) + "_right");
     ASSERT_GE(ri, 0) << l.name;
     const Muscle &r = m.muscles[static_cast<size_t>(ri)];
-    Eigen::Vector3d image = m.tissue.X0.row(l.node_a).transpose();
-    image.x() = -image.x();
-    EXPECT_LT((image - m.tissue.X0.row(r.node_a).transpose()).norm(), 0.05) << l.name << ": attachments not alike";
+    // The cheek puffs push from half the mouth's width inside their own
+    // cheek's FDP (5.1, 5.2), which on Song are not mirror images (x 17.0
+    // and -19.7, depth 37.1 and 35.1): their attachments follow, only their
+    // fibres are alike.
+    if (l.name.rfind("cheek_puff_", 0) != 0) {
+      Eigen::Vector3d image = m.tissue.X0.row(l.node_a).transpose();
+      image.x() = -image.x();
+      EXPECT_LT((image - m.tissue.X0.row(r.node_a).transpose()).norm(), 0.05) << l.name << ": attachments not alike";
+    }
     EXPECT_NEAR(l.length, r.length, 0.01 * l.length) << l.name;
     ++pairs;
   }
-  EXPECT_EQ(pairs, 14);  // the paper's 11 linear pairs, the nostril dilators, the depressores supercilii and labii
+  // The paper's 11 linear pairs, the nostril dilators, the cheek puffs, the
+  // depressores supercilii and labii.
+  EXPECT_EQ(pairs, 15);
 }

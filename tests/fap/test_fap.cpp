@@ -135,12 +135,12 @@ const Built &head_1k() {
     // orbicularis oculi; nasalis for FAP 64; the left lids' drivers: the
     // upper one calibrates to half its range (FAP 19 then turns the lid as
     // a whole), the lower one to all of it; FAP 4's group (both upper lips)
-    // and its helper, the upper lip's protrusion driver.
+    // and its helper, the upper lip's protrusion driver; FAP 39's cheek puff.
     fo.calibrate_only = {"zygomaticus_major_left", "depressor_anguli_left", "frontalis_major_left", "corrugator_left",
                          "mentalis_left", "mentalis_right", "zygomaticus_minor_left", "upper_lip_left",
                          "risorius_left", "orbicularis_oris", "orbicularis_oculi_left", "nasalis_left",
                          "nasalis_right", "palpebral_upper_left", "palpebral_lower_left", "upper_lip_right",
-                         "lip_protrusion_upper", "chin_raiser"};
+                         "lip_protrusion_upper", "chin_raiser", "cheek_puff_left"};
     b = afmtest::build_reference_model(1000, fo);
   }
   return *b;
@@ -2076,6 +2076,45 @@ TEST(FapPartition, WeightsAreEvenedOutWhereAShareTurnsTheSkinOver) {
   const UnfoldedShares none = unfold_shared_weights(X, F, t, calm, turned, 1);
   EXPECT_EQ(none.vertices, 0);
   for (size_t k = 0; k < 2; ++k) EXPECT_EQ(calm.weight[k], calm0.weight[k]) << k;
+}
+
+// The cheek puffs (39, 40) are air pressure, not a pose of muscles that
+// other FAPs use: their targets keep all the skin they move, and no other
+// target gives them a share of its own (FapMapping::own_skin). Streams lift
+// the cheeks (41) and raise the corners (12) without puffing them; split
+// with the puff, those targets lost the skin beside 5.1 (Song's joy.fap
+// then turned a triangle). Here 12's and 41's targets are the same made
+// with 39 or without it, and 39's the same made alone.
+TEST(FapPartition, TheCheekPuffTakesNoShareAndGivesNone) {
+  const Built &b = head_1k();
+  auto targets = [&](std::vector<int> faps) {
+    FapSynthesisOptions o;
+    o.only = std::move(faps);
+    Expected<FapSynthesis> syn = synthesize_faps(b.head.scene, b.model, o);
+    EXPECT_TRUE(syn.is_ok()) << syn.status().message();
+    std::map<std::pair<int, int>, Eigen::MatrixXd> out;  // (FAP, reference) -> the skin's displacement
+    if (!syn.is_ok()) return out;
+    for (size_t t = 0, k = 0; k < syn->outcomes.size(); ++k) {
+      const FapOutcome &made = syn->outcomes[k];
+      if (!made.made) continue;
+      out[{made.number, made.reference}] = syn->targets[t++].displacement[static_cast<size_t>(b.model.skin)];
+    }
+    return out;
+  };
+  const auto with = targets({12, 39, 41}), without = targets({12, 41}), alone = targets({39});
+  ASSERT_EQ(alone.size(), 2u) << "FAP 39, both sides";
+  ASSERT_EQ(with.size(), without.size() + alone.size());
+  for (const auto &[key, D] : without) {
+    ASSERT_EQ(with.count(key), 1u) << key.first << " at " << key.second;
+    EXPECT_EQ((with.at(key) - D).cwiseAbs().maxCoeff(), 0.0) << "FAP " << key.first << " at " << key.second
+                                                             << " changed when made with the puff";
+  }
+  for (const auto &[key, D] : alone) {
+    ASSERT_EQ(with.count(key), 1u) << key.first << " at " << key.second;
+    EXPECT_EQ((with.at(key) - D).cwiseAbs().maxCoeff(), 0.0) << "FAP 39 at " << key.second
+                                                             << " changed when made with 12 and 41";
+    EXPECT_GT(D.cwiseAbs().maxCoeff(), 0.0);
+  }
 }
 
 // Real streams send the inner and outer lip FAPs together at equal values.
