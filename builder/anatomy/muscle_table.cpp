@@ -104,10 +104,11 @@ const std::vector<MuscleDef> kTable = {
     // mentalis, driven as a push on the lower lip, leaves out. A fibre along
     // the bone from the chin boss (2.10) up toward the lower lip's middle
     // (8.2), on the skull under it; +100 % takes the boss a fifth of the way
-    // up. Both ends are FDPs, which a simulation mesh keeps anyway: a key
-    // point of its own, halfway, changed the 10k head's mesh and with it
-    // its lower lip's targets.
-    {"chin_raiser", K::Linear, "8.2", "2.10", nullptr, 0.225, +1, 0.20, 0.05, false, false, false, L::Surface},
+    // up, -100 % (a push) as far down: at a twentieth, four times the range
+    // took Song's boss 44 % of FAP 18's way down. Both ends are FDPs, which a
+    // simulation mesh keeps anyway: a key point of its own, halfway, changed
+    // the 10k head's mesh and with it its lower lip's targets.
+    {"chin_raiser", K::Linear, "8.2", "2.10", nullptr, 0.225, +1, 0.20, 0.20, false, false, false, L::Surface},
     // The inner brow lowered (not in the paper; docs/anatomy.md "Depressor
     // supercilii"): the small muscle from the orbit's inner rim up into the
     // inner brow's skin (with corrugator and procerus, FACS AU 4). The
