@@ -34,7 +34,9 @@ using L = PullLine;
 //    FAPs 37/38 move, lies behind its attachment, outside its influence
 //    area. Anatomically it rises from the bone at the brows' inner ends and
 //    inserts in the mid-brow skin: attachment a third of the way from 4.1
-//    to 4.2, insertion 4.3.
+//    to 4.2, insertion 4.3. Its push (-100 %) goes as far as its pull: with
+//    a third of it, FAPs 37/38's negative sides stopped at half their
+//    reference, at four times that range.
 //  - mentalis: the paper's attachment 2.1 + (2.1 - m) mirrors a point through
 //    the chin in depth too, in front of the face on Song, whose two short
 //    fibres then missed the lower lip's middle. From the chin straight below
@@ -46,8 +48,8 @@ const std::vector<MuscleDef> kTable = {
     {"frontalis_major_right", K::Linear, "11.1 + 1/3 (11.2 - 11.1)", "4.4", nullptr, 0.30, +1, 0.18, 0.06, false, false, false, L::Surface},
     {"frontalis_outer_left", K::Linear, "11.1 + 2/3 (11.3 - 11.1)", "4.5", nullptr, 0.30, +1, 0.18, 0.06, false, false, false, L::Surface},
     {"frontalis_outer_right", K::Linear, "11.1 + 2/3 (11.2 - 11.1)", "4.6", nullptr, 0.30, +1, 0.18, 0.06, false, false, false, L::Surface},
-    {"corrugator_left", K::Linear, "4.1 + 1/3 (4.2 - 4.1)", "4.3", nullptr, 0.40, +1, 0.25, 0.08, false, false, false, L::Surface},
-    {"corrugator_right", K::Linear, "4.2 + 1/3 (4.1 - 4.2)", "4.4", nullptr, 0.40, +1, 0.25, 0.08, false, false, false, L::Surface},
+    {"corrugator_left", K::Linear, "4.1 + 1/3 (4.2 - 4.1)", "4.3", nullptr, 0.40, +1, 0.25, 0.25, false, false, false, L::Surface},
+    {"corrugator_right", K::Linear, "4.2 + 1/3 (4.1 - 4.2)", "4.4", nullptr, 0.40, +1, 0.25, 0.25, false, false, false, L::Surface},
     {"nasalis_left", K::Linear, "9.7", "9.1", nullptr, 0.30, +1, 0.15, 0.05, false, false, false, L::Skull},
     {"nasalis_right", K::Linear, "9.6", "9.2", nullptr, 0.30, +1, 0.15, 0.05, false, false, false, L::Skull},
     {"upper_lip_left", K::Linear, "9.5 + 1/2 (9.15 - 9.5)", "8.10", nullptr, 0.40, -1, 0.40, 0.15, false, true, false, L::Skull},

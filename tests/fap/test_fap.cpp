@@ -1554,6 +1554,29 @@ TEST(FapSynthesis, TheChinRaiserTakesTheChinBossToItsReference) {
   EXPECT_FALSE(skin_faults(m, s.X0.topRows(s.n) + L).any());
 }
 
+// The brows squeezed apart (FAP 37's negative side: corrugator pushed back
+// along its fibre). With a push of a third of its pull's range, four times
+// that took the 1k head's inner brow 49 % of the way (Song's 52 %, the 10k
+// head's 40 %); with the push as far as the pull, the tissue is what stops
+// it: the 1k head 73 %, Song and the 10k head all of it (muscle_table.cpp).
+TEST(FapSynthesis, TheCorrugatorsPushSpreadsTheBrowsAsFarAsTheTissueLets) {
+  const Built &b = head_1k();
+  FapSynthesisOptions o;
+  o.only = {37};
+  Expected<FapSynthesis> syn = synthesize_faps(b.head.scene, b.model, o);
+  ASSERT_TRUE(syn.is_ok()) << syn.status().message();
+  // The side's target at the table's reference: its own, or the hold of
+  // its reach (fap_synthesis.h, "Reach, then hold"), whose `reached` is the
+  // share of the motion at the reference.
+  const FapOutcome *apart = nullptr;
+  for (const FapOutcome &out : syn->outcomes)
+    if (out.made && out.reference == -find_fap_mapping(37)->reference) apart = &out;
+  ASSERT_NE(apart, nullptr) << "no target for FAP 37's negative side";
+  std::printf("FAP 37 at %d: %.0f %% of the prescribed motion, %.1f %% off the direction\n", apart->reference,
+              100 * apart->reached, 100 * apart->off_axis);
+  EXPECT_GT(apart->reached, 0.65) << apart->message;
+}
+
 TEST(FapSynthesis, AMissingMuscleIsAReportNotAnError) {
   const Built &b = head_1k();
   // FAP 38 needs corrugator_right, which this model did not calibrate: the
