@@ -86,9 +86,8 @@ struct MuscleDef {
   // bone (frontalis, corrugator, zygomaticus major, risorius, depressor
   // anguli, the chin raiser, depressor supercilii), Key for the pushes
   // (mentalis, the lip protrusion drivers, the nostril dilators, the cheek
-  // puffs) and
-  // depressor labii's pull, Skull for the others (nasalis, upper lip,
-  // zygomaticus minor). Others: Skull (unused).
+  // puffs) and depressor labii's pull, Skull for the others (nasalis, upper
+  // lip, zygomaticus minor). Others: Skull (unused).
   PullLine line;
   // Lid: the eye's corners (outer, inner), where the margin is held: the
   // load fades to nothing there. Others: nullptr.
@@ -107,8 +106,9 @@ struct MuscleDef {
 // right, then Table 2), then the four lid drivers (upper left, upper right,
 // lower left, lower right), then the two lip protrusion drivers (upper,
 // lower), the two nostril dilators (left, right) and the two cheek puffs
-// (left, right): linear muscles that push; last the chin raiser and the two depressores supercilii (left,
-// right), linear muscles that pull.
+// (left, right): linear muscles that push; last the chin raiser, the two
+// depressores supercilii and the two depressores labii (left, right),
+// linear muscles that pull.
 const std::vector<MuscleDef> &muscle_table();
 // "linear", "sphincter", "lid".
 const char *muscle_kind_name(MuscleKind kind);

@@ -155,7 +155,7 @@ std::vector<FapMapping> make_table() {
   // ---- group 5: cheeks ----
   add(39, D::Muscles, 60, {{"cheek_puff_left", 100}}, {{"cheek_puff_left", -100}}, "air pressure in the mouth");
   add(40, D::Muscles, 60, {{"cheek_puff_right", 100}}, {{"cheek_puff_right", -100}}, "air pressure in the mouth");
-  t[t.size() - 2].own_skin = t.back().own_skin = true;
+  t[t.size() - 2].own_skin = t.back().own_skin = true;  // no share of the skin (fap_mapping.h)
   add(41, D::Muscles, 120, {{"zygomaticus_major_left", 100}, {"zygomaticus_minor_left", 100}}, {}, "");
   add(42, D::Muscles, 120, {{"zygomaticus_major_right", 100}, {"zygomaticus_minor_right", 100}}, {}, "");
   // ---- group 6: tongue ----

@@ -66,11 +66,11 @@ struct FapMapping {
   // (3.1/3.3 or 3.2/3.4) and blended over the lids' opening. 0: not a lid.
   int lid = 0;
   // The cheek puffs (39, 40): air pressure, not a pose of muscles that
-  // other FAPs use. Its targets keep all the skin they move, and no other
+  // other FAPs use. Their targets keep all the skin they move, and no other
   // target gives them a share of its own (fap_partition.h): streams lift the
-  // cheeks (41, 42) without puffing them (every Xface stream), and split
-  // with the puff, the lift stopped short beside 5.1 (Song's joy.fap turned
-  // a triangle in 2 frames).
+  // cheeks (41, 42) and move the corners without puffing them (every Xface
+  // stream), and split with the puff, those targets stopped short beside
+  // 5.1 (Song's joy.fap turned a triangle in 2 frames).
   bool own_skin = false;
   // In-between targets past `reference` on the positive side, FAP units,
   // ascending (formats/afm.md: the player blends a side's targets piecewise

@@ -1493,11 +1493,11 @@ TEST(FapSynthesis, AGroupThatFoldsBeyondItsRangeStopsShortOfTheFold) {
 }
 
 // FAP 18 raises the chin boss (2.10) by the chin raiser, mentalis' pull on
-// the chin's skin, and lowers it by its push (docs/anatomy.md, "Chin raiser"). Mentalis' push on the
-// lower lip, which had it, took the chin 33 % of the reference on the 2k
-// head, 51 % on the 10k and 28 % on Song, and no further at 4 times its
-// range; the raiser takes it all of the way, near the FAP's direction, and
-// keeps the skin a face.
+// the chin's skin, and lowers it by its push (docs/anatomy.md, "Chin
+// raiser"). Mentalis' push on the lower lip, which had it, took the chin 33 %
+// of the reference on the 2k head, 51 % on the 10k and 28 % on Song, and no
+// further at 4 times its range; the raiser takes it all of the way, near
+// the FAP's direction, and keeps the skin a face.
 TEST(FapSynthesis, TheChinRaiserTakesTheChinBossToItsReference) {
   const Built &b = head_1k();
   const FaceModel &m = b.model;
