@@ -648,7 +648,6 @@ Eigen::MatrixXd lift_displacement(const SimMesh &sim, const Eigen::MatrixXd &Dc)
 std::vector<int> lifted_turned_faces(const SimMesh &sim, const Eigen::MatrixXd &Dc, double *share) {
   Eigen::MatrixXd V = lift_displacement(sim, Dc);
   V += sim.skin_V;
-  if (sim.skin_rest.length.size() != sim.skin_F.rows()) return turned_faces(sim.skin_V, sim.skin_F, V, share);
   return turned_faces(sim.skin_rest, sim.skin_F, V, share);
 }
 

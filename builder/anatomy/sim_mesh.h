@@ -75,7 +75,7 @@ struct SimMesh {
   SkinBinding binding;      // #V rows: each skin vertex's coarse triangle and weights
   Eigen::MatrixXd skin_V;   // #V x 3 the skin's own rest positions, model units
   Eigen::MatrixXi skin_F;   // #F x 3 the skin's own triangles into skin_V
-  RestFaces skin_rest;      // rest_faces(skin_V, skin_F), for lifted_turned_faces
+  RestFaces skin_rest;      // rest_faces(skin_V, skin_F), for lifted_turned_faces (make_sim_mesh sets it)
   // A mirror-symmetric skin (nine in ten vertices with an image) is
   // decimated in mirror pairs; `unpaired`: collapses whose image could not
   // follow (0: the coarse mesh is as symmetric as the skin).
