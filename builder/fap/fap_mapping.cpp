@@ -173,10 +173,8 @@ std::vector<FapMapping> make_table() {
   // ---- group 9: nose ----
   add(61, D::Muscles, 100, {{"dilator_naris_left", 100}}, {{"dilator_naris_left", -100}}, "the nose's wing flared");
   add(62, D::Muscles, 100, {{"dilator_naris_right", 100}}, {{"dilator_naris_right", -100}}, "the nose's wing flared");
-  add(63, D::Muscles, 60, {{"nasalis_left", 100}, {"nasalis_right", 100}},
-      {{"nasalis_left", -100}, {"nasalis_right", -100}}, "");
-  add(64, D::Muscles, 60, {{"nasalis_left", 100}, {"nasalis_right", -100}},
-      {{"nasalis_right", 100}, {"nasalis_left", -100}}, "");
+  add(63, D::Muscles, 60, {{"nose_raise", 100}}, {{"nose_lower", 100}}, "the nose's tip raised");
+  add(64, D::Muscles, 60, {{"nose_bend_right", 100}}, {{"nose_bend_left", 100}}, "the nose's tip bent sideways");
   // ---- group 10: ears ----
   for (int f = 65; f <= 68; ++f)
     add(f, D::None, 0, {}, {}, "human ears do not move: the auricular muscles are vestigial");

@@ -11,6 +11,7 @@
 #include <iterator>
 #include <map>
 #include <memory>
+#include <tuple>
 
 #include "anatomy/face_model.h"
 #include "anatomy/fdp_completion.h"
@@ -185,11 +186,14 @@ int penetrating_nodes(const SkinModel &s, const Eigen::MatrixXd &X, double slack
 
 TEST(MuscleTable, TwentyFiveMusclesWithParsableKeyPoints) {
   const auto &t = muscle_table();
-  ASSERT_EQ(t.size(), 40u) << "the paper's 25, four lid drivers, two lip protrusion drivers, two nostril dilators, "
-                               "two cheek puffs, the chin raiser, two depressores supercilii, two depressores labii";
+  ASSERT_EQ(t.size(), 44u) << "the paper's 25, four lid drivers, two lip protrusion drivers, two nostril dilators, "
+                               "two cheek puffs, the chin raiser, two depressores supercilii, two depressores labii, "
+                               "the nose's four tip drivers";
   // The last rows: mentalis' pull on the chin's skin and the inner brows'
   // depressors, linear muscles that pull along the bone, then the lower
-  // lip's depressors, which pull toward their attachment on the chin's skin.
+  // lip's depressors, which pull toward their attachment on the chin's skin,
+  // and the nose's tip drivers, which pull the tip toward a point beside,
+  // above or below it.
   struct Puller {
     const char *name, *insertion;
     PullLine line;
@@ -198,7 +202,11 @@ TEST(MuscleTable, TwentyFiveMusclesWithParsableKeyPoints) {
                             {"depressor_supercilii_left", "4.1", PullLine::Surface},
                             {"depressor_supercilii_right", "4.2", PullLine::Surface},
                             {"depressor_labii_left", "8.7", PullLine::Key},
-                            {"depressor_labii_right", "8.8", PullLine::Key}};
+                            {"depressor_labii_right", "8.8", PullLine::Key},
+                            {"nose_bend_left", "9.3", PullLine::Key},
+                            {"nose_bend_right", "9.3", PullLine::Key},
+                            {"nose_raise", "9.3", PullLine::Key},
+                            {"nose_lower", "9.3", PullLine::Key}};
   const long first_puller = static_cast<long>(t.size()) - static_cast<long>(std::size(pullers));
   int linear = 0, sphincter = 0;
   for (const MuscleDef &d : t) {
@@ -764,6 +772,30 @@ TEST(Physics, EachMuscleMovesItsRegionTheWayAnatomySays) {
     EXPECT_GT(sign * along, 0.5 * total) << name << " moves its area along its rest normals";
     EXPECT_LT(o.norm(), 0.1 * std::abs(d.x())) << name << ": the right cheek stays";
     EXPECT_LT(lips, 0.3 * std::abs(d.x())) << name << ": the lips' middles stay";
+    EXPECT_EQ(inverted_elements(m.tissue, X), 0) << name;
+    EXPECT_EQ(penetrating_nodes(m.tissue, X, 1e-9), 0) << name;
+    EXPECT_TRUE(X.allFinite()) << name;
+  }
+  // The nose's tip drivers move the tip (9.3) their own way, the left
+  // bender to the face's left (+x), the raiser up, the lowerer down, more
+  // along it than across, and leave the wings (9.1, 9.2) and the upper
+  // lip's middle (8.1) mostly in place (docs/anatomy.md, "Nose tip
+  // drivers"). Nasalis, which FAPs 63 and 64 had, takes the wing back and
+  // up.
+  for (const auto &[name, axis, sign] : {std::tuple<const char *, int, double>{"nose_bend_left", 0, +1},
+                                         std::tuple<const char *, int, double>{"nose_raise", 1, +1},
+                                         std::tuple<const char *, int, double>{"nose_lower", 1, -1}}) {
+    const Eigen::MatrixXd X = contract(m, name, t);
+    const Eigen::Vector3d d = moved(m, X, "9.3");
+    const double own = sign * d[axis], across = (d - d[axis] * Eigen::Vector3d::Unit(axis)).norm();
+    const double wings = std::max(moved(m, X, "9.1").norm(), moved(m, X, "9.2").norm()),
+                 lip = moved(m, X, "8.1").norm();
+    std::printf("%s: 9.3 along %.3f mm, across %.3f mm; the wings move %.3f mm, 8.1 %.3f mm\n", name, mm(own),
+                mm(across), mm(wings), mm(lip));
+    EXPECT_GT(own, 0.1e-3) << name;
+    EXPECT_LT(across, 0.15 * own) << name << ": along its axis, not across";
+    EXPECT_LT(wings, 0.2 * own) << name << ": the wings stay";
+    EXPECT_LT(lip, 0.1 * own) << name << ": the upper lip stays";
     EXPECT_EQ(inverted_elements(m.tissue, X), 0) << name;
     EXPECT_EQ(penetrating_nodes(m.tissue, X, 1e-9), 0) << name;
     EXPECT_TRUE(X.allFinite()) << name;

@@ -12,7 +12,7 @@ bin="$bin/afm-build"
 
 "$bin" --help | grep -q -- "--muscle-map" || fail "--help does not list --muscle-map"
 "$bin" --list-muscles | grep -q "^orbicularis_oris .*sphincter" || fail "--list-muscles lacks orbicularis_oris"
-[ "$("$bin" --list-muscles | grep -c '^[a-z]')" -eq 41 ] || fail "--list-muscles does not list the 25 muscles, 4 lid drivers, 2 lip protrusion drivers, 2 nostril dilators, 2 cheek puffs, the chin raiser, the 2 depressores supercilii and the 2 depressores labii"
+[ "$("$bin" --list-muscles | grep -c '^[a-z]')" -eq 45 ] || fail "--list-muscles does not list the 25 muscles, 4 lid drivers, 2 lip protrusion drivers, 2 nostril dilators, 2 cheek puffs, the chin raiser, the 2 depressores supercilii, the 2 depressores labii and the nose's 4 tip drivers"
 
 "$bin" --list-faps | grep -q "^ 3 open_jaw  *jaw-open" || fail "--list-faps lacks open_jaw"
 [ "$("$bin" --list-faps | grep -c '^ *[0-9]')" -eq 66 ] || fail "--list-faps does not list FAPs 3..68"

@@ -176,13 +176,13 @@ TEST(Candide3, TargetsMoveTheWayCandidesFapBlocksDo) {
   // Per target with a Candide block: the motion-weighted mean cosine over
   // the block's vertices that our target moves by at least a fifth of its
   // largest motion there. Known disagreements (docs/fap_mapping.md), FAP
-  // and side: nasalis bends the nose's tip back and up rather than sideways
-  // (64). They must stay listed until fixed, and come off the list when
-  // they agree, as the lips pushed out (16, 17) and the nose's wings (61, 62
-  // negative) did when their drivers came (muscle_table.h): orbicularis oris
-  // had moved the lips up and sideways more than forward, nasalis the wings
-  // back and up.
-  const std::vector<std::pair<int, int>> known = {{64, +1}, {64, -1}};
+  // and side, would be listed here until fixed, and come off the list when
+  // they agree. None is left: the lips pushed out (16, 17), the nose's
+  // wings (61, 62 negative) and its tip bent (64) came off it when their
+  // drivers came (muscle_table.h): orbicularis oris had moved the lips up
+  // and sideways more than forward, nasalis the wings and the tip back and
+  // up.
+  const std::vector<std::pair<int, int>> known = {};
   int compared = 0, skipped = 0;
   std::string table;
   for (size_t t = 0, o = 0; o < syn->outcomes.size(); ++o) {
