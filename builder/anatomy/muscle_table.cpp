@@ -132,13 +132,17 @@ const std::vector<MuscleDef> kTable = {
     // FAPs only (fap_mapping.cpp).
     {"depressor_labii_left", K::Linear, "8.7 + (2.10 - 8.2)", "8.7", nullptr, 0.40, +1, 0.35, 0.08, false, false, false, L::Key},
     {"depressor_labii_right", K::Linear, "8.8 + (2.10 - 8.2)", "8.8", nullptr, 0.40, +1, 0.35, 0.08, false, false, false, L::Key},
-    // The nose's tip bent sideways (not in the paper; docs/anatomy.md "Nose
-    // benders"): MPEG-4's bend_nose (FAP 64) moves the tip (9.3) to either
-    // side, which the paper's nasalis, pulling each wing back and up, does
-    // not (Song's tip moved less than a FAP unit). A pull on the tip toward
-    // a point beside it, level with it, half the wings' distance out (x on
-    // a level nose); the load on the tissue's whole thickness, as the
-    // cartilage moves as one. +100 % takes the tip a fifth of the fibre.
+    // The nose's tip moved (not in the paper; docs/anatomy.md "Nose tip
+    // drivers"): MPEG-4's bend_nose and raise_nose (FAPs 64, 63) move the
+    // tip (9.3) sideways, up and down, which the paper's nasalis, pulling
+    // each wing back and up, barely does (Song's tip moved less than a FAP
+    // unit sideways). Each a pull on the tip toward a point level with it:
+    // beside it by the wings' distance (x on a level nose; at half that
+    // distance the tip came forward too), or above or below it by a
+    // quarter of the way from the pupils to the chin (the face's vertical).
+    // The load on the tissue's whole thickness, as the cartilage moves as
+    // one. +100 % takes the tip a tenth of the fibre sideways, 15 % up or
+    // down.
     {"nose_bend_left", K::Linear, "9.3 + (9.1 - 9.2)", "9.3", nullptr, 0.25, +1, 0.10, 0.05, false, false, false, L::Key, nullptr, nullptr, true},
     {"nose_bend_right", K::Linear, "9.3 + (9.2 - 9.1)", "9.3", nullptr, 0.25, +1, 0.10, 0.05, false, false, false, L::Key, nullptr, nullptr, true},
     {"nose_raise", K::Linear, "9.3 + 1/8 (3.5 - 2.1) + 1/8 (3.6 - 2.1)", "9.3", nullptr, 0.30, +1, 0.15, 0.05, false, false, false, L::Key, nullptr, nullptr, true},

@@ -5,9 +5,10 @@
 // the nose's wings (docs/anatomy.md "Nostril dilators"), two that puff
 // the cheeks out (air pressure in the mouth: docs/anatomy.md "Cheek
 // puff"), one that raises the chin (docs/anatomy.md "Chin raiser"), two
-// that lower the inner brows (docs/anatomy.md "Depressor supercilii") and
-// two that lower the lower lip (docs/anatomy.md "Depressor labii
-// inferioris").
+// that lower the inner brows (docs/anatomy.md "Depressor supercilii"), two
+// that lower the lower lip (docs/anatomy.md "Depressor labii inferioris")
+// and four that move the nose's tip up, down and sideways (docs/anatomy.md
+// "Nose tip drivers").
 //
 // Key points are written as in the paper, affine combinations of FDP
 // positions: "11.1 + 1/6 (11.3 - 11.1)". parse_keypoint() turns one into
@@ -40,7 +41,8 @@ enum class MuscleKind { Linear, Sphincter, Lid };
 //   Key      straight toward the attachment's key point itself, on the
 //            skin's surface where the FDPs are: a push from below the skin,
 //            or a pull toward a point on the skin that stands forward of
-//            the insertion (the lower lip turned out as it comes down).
+//            the insertion (the lower lip turned out as it comes down),
+//            or toward a point off it (the nose's tip drawn sideways).
 enum class PullLine { Skull, Surface, Key };
 
 // One row of Table 1 or 2 plus the constants the paper leaves to the
@@ -86,8 +88,9 @@ struct MuscleDef {
   // bone (frontalis, corrugator, zygomaticus major, risorius, depressor
   // anguli, the chin raiser, depressor supercilii), Key for the pushes
   // (mentalis, the lip protrusion drivers, the nostril dilators, the cheek
-  // puffs) and depressor labii's pull, Skull for the others (nasalis, upper
-  // lip, zygomaticus minor). Others: Skull (unused).
+  // puffs) and the pulls toward a point on or off the skin (depressor labii,
+  // the nose's tip drivers), Skull for the others (nasalis, upper lip,
+  // zygomaticus minor). Others: Skull (unused).
   PullLine line;
   // Lid: the eye's corners (outer, inner), where the margin is held: the
   // load fades to nothing there. Others: nullptr.
@@ -96,7 +99,8 @@ struct MuscleDef {
   // hypodermal nodes, a third each, instead of the dermal node alone: a
   // muscle inside the tissue it moves (the lip protrusion drivers: the lip's
   // own orbicularis; the nostril dilators: the wing's; the cheek puffs:
-  // the air's pressure on the cheek from inside), not under it.
+  // the air's pressure on the cheek from inside; the nose's tip drivers: the
+  // cartilage, moved as one), not under it.
   // Pushed by its dermis alone, the upper lip's dermis passed through its
   // epidermis (docs/anatomy.md).
   bool whole_thickness = false;
@@ -107,8 +111,9 @@ struct MuscleDef {
 // lower left, lower right), then the two lip protrusion drivers (upper,
 // lower), the two nostril dilators (left, right) and the two cheek puffs
 // (left, right): linear muscles that push; last the chin raiser, the two
-// depressores supercilii and the two depressores labii (left, right),
-// linear muscles that pull.
+// depressores supercilii, the two depressores labii (left, right) and the
+// nose's tip drivers (bend left, bend right, raise, lower), linear muscles
+// that pull.
 const std::vector<MuscleDef> &muscle_table();
 // "linear", "sphincter", "lid".
 const char *muscle_kind_name(MuscleKind kind);

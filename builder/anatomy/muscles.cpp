@@ -258,8 +258,9 @@ Expected<Muscle> place_muscle(const SkinModel &skin, const FdpSet &fdps, int def
     m.node_b = key_node(skin, fdps, kDermis, keys[1], m.key_b);
     // A muscle inside the tissue it moves (whole_thickness) has no skull
     // attachment: its fibre runs from the key point itself. The skull node
-    // nearest a point inside the mouth or the nose can lie anywhere (the
-    // 2,000-vertex head's lip drivers took one on a cheek, to one side).
+    // nearest a point inside the mouth or the nose, or beside the nose's
+    // tip, can lie anywhere (the 2,000-vertex head's lip drivers took one
+    // on a cheek, to one side).
     const Eigen::Vector3d a = d.whole_thickness ? m.key_a : Eigen::Vector3d(skin.X0.row(m.node_a).transpose());
     const Eigen::Vector3d b = skin.X0.row(m.node_b);
     m.length = (b - a).norm();

@@ -235,8 +235,9 @@ Status check_muscle(const FaceModel &model, const Muscle &m, const std::string &
 // linear attachment green and insertion red, sphincter semi-axis nodes red;
 // a lid driver's line from its margin (red) to the other lid's. A muscle
 // inside the tissue it moves (MuscleDef::whole_thickness: the lips' and the
-// nose's drivers) shows its insertion only: its fibre starts at a point
-// inside the mouth or the nose, not on the skull.
+// nose's drivers, the cheek puffs) shows its insertion only: its fibre
+// starts at a point inside the mouth or the nose, or beside the nose's
+// tip, not on the skull.
 void muscle_overlay(const FaceModel &model, const Epidermis &skin, const Scale &scale,
                     const Muscle &m, bool key_dots, std::vector<SceneMarkers> &lines,
                     std::vector<SceneMarkers> &dots) {
