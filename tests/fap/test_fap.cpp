@@ -219,10 +219,19 @@ const MorphTarget *target(int fap, int side) {
   return nullptr;
 }
 
-// A FAP's target at `reference` (its side's nearest, or an in-between), or nullptr.
-const MorphTarget *target_at(int fap, int reference) {
-  for (const MorphTarget &t : synthesis().targets)
+// A FAP's target at `reference` (its side's nearest, or an in-between) in
+// `syn` (default: synthesis()), or nullptr.
+const MorphTarget *target_at(const FapSynthesis &syn, int fap, int reference) {
+  for (const MorphTarget &t : syn.targets)
     if (t.kind == AFM_TARGET_FAP && t.number == fap && t.reference == reference) return &t;
+  return nullptr;
+}
+const MorphTarget *target_at(int fap, int reference) { return target_at(synthesis(), fap, reference); }
+
+// The outcome of a FAP side made at `reference` in `syn`, or nullptr.
+const FapOutcome *made_at(const FapSynthesis &syn, int fap, int reference) {
+  for (const FapOutcome &o : syn.outcomes)
+    if (o.kind == AFM_TARGET_FAP && o.made && o.number == fap && o.reference == reference) return &o;
   return nullptr;
 }
 
@@ -1569,9 +1578,7 @@ TEST(FapSynthesis, TheCorrugatorsPushSpreadsTheBrowsAsFarAsTheTissueLets) {
   // The side's target at the table's reference: its own, or the hold of
   // its reach (fap_synthesis.h, "Reach, then hold"), whose `reached` is the
   // share of the motion at the reference.
-  const FapOutcome *apart = nullptr;
-  for (const FapOutcome &out : syn->outcomes)
-    if (out.made && out.reference == -find_fap_mapping(37)->reference) apart = &out;
+  const FapOutcome *apart = made_at(*syn, 37, -find_fap_mapping(37)->reference);
   ASSERT_NE(apart, nullptr) << "no target for FAP 37's negative side";
   std::printf("FAP 37 at %d: %.0f %% of the prescribed motion, %.1f %% off the direction\n", apart->reference,
               100 * apart->reached, 100 * apart->off_axis);
@@ -1598,9 +1605,7 @@ TEST(FapSynthesis, TheNoseTipGoesUpDownAndSidewaysByItsReference) {
   for (const FapOutcome &out : syn->outcomes) {
     SCOPED_TRACE("FAP " + std::to_string(out.number) + " at " + std::to_string(out.reference));
     ASSERT_TRUE(out.made) << out.message;
-    const MorphTarget *t = nullptr;
-    for (const MorphTarget &k : syn->targets)
-      if (k.number == out.number && k.reference == out.reference) t = &k;
+    const MorphTarget *t = target_at(*syn, out.number, out.reference);
     ASSERT_NE(t, nullptr);
     const afm_fap_info *info = afm_fap(out.number);
     const FdpPoint *fdp = m.fdps.find(FdpId{info->fdp_group, info->fdp_index}, m.skin);
@@ -1632,9 +1637,7 @@ TEST(FapSynthesis, TheUpperLipsMiddleRaisedReachesWithOrbicularisOrisParting) {
   o.only = {4};
   Expected<FapSynthesis> syn = synthesize_faps(b.head.scene, m, o);
   ASSERT_TRUE(syn.is_ok()) << syn.status().message();
-  const FapOutcome *raised = nullptr;
-  for (const FapOutcome &out : syn->outcomes)
-    if (out.made && out.reference == -find_fap_mapping(4)->reference) raised = &out;
+  const FapOutcome *raised = made_at(*syn, 4, -find_fap_mapping(4)->reference);
   ASSERT_NE(raised, nullptr) << "no target for FAP 4's negative side";
   std::printf("FAP 4 at %d, the 1k head's MNS0 3 times longer: %.0f %% of the prescribed motion, %.1f %% off "
               "the direction (%s)\n",
