@@ -605,6 +605,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         o.made = true;
         o.largest = D.rowwise().norm().maxCoeff();
         o.dynamic = static_cast<int>(pose->dynamic.size());
+        o.slabs = static_cast<int>(turned_slabs(model.tissue, pose->X).size());
         o.scale = share;
         MorphTarget t;
         t.kind = o.kind;
@@ -1185,6 +1186,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       if (map->lid && fallback) keep_lid_half(model, map->fap, map->lid, D);
       measure(o, D.row(fdp->vertex).transpose(), dir);
       o.dynamic = static_cast<int>(pose.dynamic.size());
+      o.slabs = static_cast<int>(turned_slabs(model.tissue, pose.X).size());
       o.made = true;
       MorphTarget t;
       t.kind = AFM_TARGET_FAP;
@@ -1584,6 +1586,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     fo.from_jaw = true;
     fo.reached = 1;
     fo.seconds = 0;
+    fo.slabs = 0;  // not solved: FAP 3's skin carried
     fo.prescribed = given_up_at * unit * along;
     measure(fo, E.row(v).transpose(), fap_direction(info));
     const SkinFaults faults = skin_faults(model, rest + E);

@@ -206,6 +206,9 @@ struct FapOutcome {
   int sunk = 0;                   // skull-tied skin vertices the target takes more than an
                                   // AFM quantum below their skull node's rest plane
                                   // (skin_faults), on the simulated skin
+  int slabs = 0;                  // slabs of tissue that the solved pose turns through
+                                  // themselves (turned_slabs, skin_model.h): inside the
+                                  // tissue, not in the target, which stores the skin
   int dynamic = 0;                // vertices solved
   bool mirrored = false;          // made from its left twin's recipe ("Mirror twins" above)
   double seconds = 0;

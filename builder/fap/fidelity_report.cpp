@@ -119,6 +119,7 @@ std::string fidelity_table(const FapSynthesis &s) {
   // direction by construction, have their off-axis median apart.
   std::vector<double> along, off, off_face, off_depth, reach, off_at_reach;
   int failed = 0, turning = 0, turned = 0, sinking = 0, kinematic = 0, holds = 0, from_jaw = 0;
+  int slab_turning = 0, slabs = 0, solved = 0;  // targets whose solved poses turn slabs, and how many
   for (const FapOutcome &o : s.outcomes) {
     const std::string id = target_id(o);
     const std::string name = target_label(o);
@@ -131,6 +132,11 @@ std::string fidelity_table(const FapSynthesis &s) {
     }
     if (o.turned > 0) ++turning, turned += o.turned;
     if (o.sunk > 0) ++sinking;
+    // A hold stores its reach's pose, extrapolated: counted once, with it.
+    if (!o.holds && !o.from_jaw && (o.kind != AFM_TARGET_FAP || solved_fap_target(o))) {
+      ++solved;
+      if (o.slabs > 0) ++slab_turning, slabs += o.slabs;
+    }
     if (o.kind != AFM_TARGET_FAP) {
       out += format("%-4s %-34s %6d %8s %10s %10.4g %8s %8s %7d %6d%s%s\n", id.c_str(), name.c_str(), o.reference,
                     "-", "-", o.largest, "-", "-", o.dynamic, o.turned, o.message.empty() ? "" : "  ",
@@ -172,7 +178,8 @@ std::string fidelity_table(const FapSynthesis &s) {
   out += format("targets: %zu made, %d not made; FAPs along the direction median %.2f%% worst %.2f%%; off-axis "
                 "median %.1f%% worst %.1f%% (across the face median %.1f%%, in depth %.1f%%); %zu under-reach "
                 "(median %.0f%% of the prescribed motion%s); %d turn %d skin triangles over (visemes and "
-                "expressions: achieved = largest motion)%s%s%s\n",
+                "expressions: achieved = largest motion)%s; slabs of tissue turned through themselves in the "
+                "solved poses: %d (in %d of %d targets)%s%s\n",
                 s.targets.size(), failed, 100 * median(along), 100 * worst(along), 100 * median(off),
                 100 * worst(off), 100 * median(off_face), 100 * median(off_depth), reach.size(),
                 100 * median(reach),
@@ -182,7 +189,8 @@ std::string fidelity_table(const FapSynthesis &s) {
                             .c_str()
                       : "",
                 turning, turned,
-                sinking ? format("; %d sink skin below the skull", sinking).c_str() : "",
+                sinking ? format("; %d sink skin below the skull", sinking).c_str() : "", slabs, slab_turning,
+                solved,
                 kinematic ? format("; %d targets of the tongue and pupils are exact by construction and not in "
                                    "these figures",
                                    kinematic)
@@ -209,14 +217,14 @@ Status write_fidelity_report(const std::string &dir, const Scene &scene, const F
   if (Status st = write_file_atomic(dir + sep + "report.txt", table); !st) return st;
   std::string csv =
       "kind,number,name,side,reference,reached,made,scale,prescribed_x,prescribed_y,prescribed_z,achieved_x,"
-      "achieved_y,achieved_z,along_error,off_axis,off_face,off_depth,largest,dynamic,turned,sunk,seconds,message\n";
+      "achieved_y,achieved_z,along_error,off_axis,off_face,off_depth,largest,dynamic,turned,sunk,slabs,seconds,message\n";
   for (const FapOutcome &o : s.outcomes)
-    csv += format("%s,%d,%s,%d,%d,%.4g,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%d,%.3f,",
+    csv += format("%s,%d,%s,%d,%d,%.4g,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%d,%d,%.3f,",
                   o.kind == AFM_TARGET_FAP ? "fap" : o.kind == AFM_TARGET_VISEME ? "viseme" : "expression",
                   o.number, csv_quote(target_label(o)).c_str(), o.side, o.reference, o.reached, o.made ? 1 : 0,
                   o.scale, o.prescribed.x(), o.prescribed.y(), o.prescribed.z(), o.achieved.x(), o.achieved.y(),
                   o.achieved.z(), o.along_error, o.off_axis, o.off_face, o.off_depth, o.largest, o.dynamic,
-                  o.turned, o.sunk, o.seconds) +
+                  o.turned, o.sunk, o.slabs, o.seconds) +
            csv_quote(o.message) + "\n";
   if (Status st = write_file_atomic(dir + sep + "report.csv", csv); !st) return st;
 

@@ -10,6 +10,7 @@
 #include <afm/player.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -969,6 +970,37 @@ TEST(FapSynthesis, NoTargetFlipsASkinTriangleOrSinksIntoTheSkull) {
     EXPECT_EQ(flipped, 0);
     EXPECT_EQ(sunk, 0);
   }
+}
+
+// The slabs of tissue a target's solved pose turns through itself
+// (FapOutcome::slabs, the report's `slabs`): the tissue inside the skin,
+// which the target does not store. The jaw wide open folds the tissue under
+// the chin (FAP 3's in-betweens at 640 and 1024 on the 1k head: 8 and 13
+// slabs), and the collapse floor (skin_model.h) takes every one away, as
+// it does at each muscle's range (tests/anatomy).
+TEST(FapSynthesis, TheReportCountsTheSlabsAPoseTurnsAndTheCollapseFloorLeavesNone) {
+  auto jaw_slabs = [](const FapSynthesis &s) {
+    std::vector<int> out;
+    for (const FapOutcome &o : s.outcomes)
+      if (o.kind == AFM_TARGET_FAP && o.number == 3 && o.made) out.push_back(o.slabs);
+    return out;
+  };
+  const std::vector<int> plain = jaw_slabs(synthesis());
+  ASSERT_EQ(plain.size(), 3u) << "FAP 3 at its reference and its in-betweens at 640 and 1024";
+  EXPECT_GT(*std::max_element(plain.begin(), plain.end()), 0) << "the count sees the folded chin";
+  EXPECT_NE(fidelity_table(synthesis()).find("; slabs of tissue turned through themselves in the solved poses: "),
+            std::string::npos);
+
+  FaceModelOptions fo;
+  fo.calibrate_muscles = false;
+  fo.tissue.collapse_modulus = 0.3;
+  const std::unique_ptr<Built> b = afmtest::build_reference_model(1000, fo);
+  ASSERT_TRUE(b);
+  FapSynthesisOptions o;
+  o.only = {3};
+  Expected<FapSynthesis> floored = synthesize_faps(b->head.scene, b->model, o);
+  ASSERT_TRUE(floored.is_ok()) << floored.status().message();
+  EXPECT_EQ(jaw_slabs(*floored), std::vector<int>(3, 0));
 }
 
 // The generated head's neutral lids are tangent to the iris (MPEG-4's
