@@ -430,7 +430,12 @@ Status render_pose_png(const Scene &scene, const FaceModel &model, const Pose &p
                          std::to_string(pose.X.cols()) + " node positions, the model " +
                          std::to_string(4 * model.tissue.n) + " x 3");
   if (!pose.X.allFinite()) return Status::error(path + ": the pose has non-finite positions");
-  Scene s = scene;
+  // The skin over each slab of tissue the pose turns through itself: the
+  // corners of its triangle.
+  std::vector<int> over;
+  for (const auto &[f, slab] : turned_slabs(model.tissue, pose.X))
+    for (int k = 0; k < 3; ++k) over.push_back(model.tissue.F(f, k));
+  Scene s = painted(scene, model, {{&over, kHiRed}});
   s.parts[model.skin].V = pose_epidermis(model, pose);
   for (Part &p : s.parts) {
     if (p.kind == PartKind::TeethLower || p.kind == PartKind::Tongue) p.V = moved_points(jaw, p.V);

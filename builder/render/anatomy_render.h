@@ -41,8 +41,10 @@ Status render_influence_png(const Scene &scene, const FaceModel &model, int musc
 Status render_jaw_map_png(const Scene &scene, const FaceModel &model, const std::string &path,
                           const AnatomyPictureOptions &options = {});
 
-// The face in a pose: the skin at the pose's epidermis, the lower teeth and
-// tongue moved by the jaw motion `jaw` (identity when the jaw is at rest).
+// The face in a pose: the skin at the pose's epidermis in the skin tone, red
+// over the slabs of tissue the pose turns through itself (turned_slabs,
+// skin_model.h: the corners of their triangles), the lower teeth and tongue
+// moved by the jaw motion `jaw` (identity when the jaw is at rest).
 Status render_pose_png(const Scene &scene, const FaceModel &model, const Pose &pose,
                        const Eigen::Affine3d &jaw, const std::string &path,
                        const AnatomyPictureOptions &options = {});

@@ -76,7 +76,8 @@ void usage(FILE *out) {
       "  --contract MUSCLE=PCT   contract a muscle, -100..100 %% of its calibrated range\n"
       "                          (repeatable; positive is the muscle's action)\n"
       "  --jaw PCT               open the jaw, 0..100 %% (100 %% is 20 degrees)\n"
-      "  --pose FILE.png         solve the pose given by --contract/--jaw and draw it\n"
+      "  --pose FILE.png         solve the pose given by --contract/--jaw and draw it,\n"
+      "                          red over the slabs of tissue it turns through themselves\n"
       "  -o FACE.afm             synthesize the morph targets (each FAP, viseme and\n"
       "                          expression; the eyelids also at 600 and, upper, 1024:\n"
       "                          in-betweens, where the lid reaches them, or at the value\n"
@@ -468,7 +469,7 @@ int main(int argc, char **argv) {
       if (d > worst) worst = d, at = v;
     }
     std::printf("pose: %zu dynamic vertices, %d iterations (%d CG), %.3f s; largest motion %.4g at vertex %d; "
-                "%zu slabs of tissue turned through themselves\n",
+                "slabs of tissue turned through themselves: %zu\n",
                 pose->dynamic.size(), pose->stats.iterations, pose->stats.cg_iterations, pose->stats.seconds,
                 worst, at, turned_slabs(t, pose->X).size());
     if (!pose_png.empty()) {

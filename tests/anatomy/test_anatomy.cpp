@@ -3,6 +3,7 @@
 // Direction tests contract one muscle of an uncalibrated model at a fixed
 // tension and solve on the whole skin (no dynamic set involved), then look at
 // the FDPs anatomy says the muscle moves.
+#include <afm/image.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -17,6 +18,7 @@
 #include "anatomy/fdp_completion.h"
 #include "anatomy/muscle_table.h"
 #include "anatomy/sim_mesh.h"
+#include "render/anatomy_render.h"
 #include "io/load_face.h"
 #include "refhead/head_shape.h"
 #include "refhead/refhead.h"
@@ -362,6 +364,49 @@ TEST(SkinModel, TurnedSlabsFindsALayerPushedThroughItself) {
   const std::vector<std::pair<int, int>> t = turned_slabs(s, pushed(f_tied, 2)), u = turned_slabs(s, pushed(f_free, 2));
   EXPECT_NE(std::find(t.begin(), t.end(), std::make_pair(f_tied, 2)), t.end());
   EXPECT_EQ(std::find(u.begin(), u.end(), std::make_pair(f_free, 2)), u.end());
+}
+
+// `afm-build --pose` draws the skin red over the slabs a pose turns through
+// itself (render_pose_png): none at rest; with every epidermal node pushed
+// through the dermis, the skin it shows.
+TEST(SkinModel, ThePosePictureIsRedOverTheTurnedSlabsOnly) {
+  const Built &b = head_1k();
+  const SkinModel &s = b.model.tissue;
+  AnatomyPictureOptions po;
+  po.width = 240, po.height = 288, po.front_only = true;
+  const std::string dir = afmtest::temp_dir("pose_picture");
+  // Pixels of the hue kHiRed (anatomy_render.cpp) shaded: red well over
+  // green and blue; and those of any skin-like warm tone, red over blue.
+  auto count = [&](const Eigen::MatrixXd &X, const char *name, int *skin) {
+    Pose pose;
+    pose.X = X;
+    const std::string path = dir + "/" + name + ".png";
+    const Status st = render_pose_png(b.head.scene, b.model, pose, Eigen::Affine3d::Identity(), path, po);
+    EXPECT_TRUE(st.ok()) << st.message();
+    afm_image im{};
+    if (afm_png_read(path.c_str(), &im) != AFM_OK) {
+      ADD_FAILURE() << "cannot read " << path;
+      return -1;
+    }
+    int red = 0;
+    *skin = 0;
+    for (int i = 0; i < im.width * im.height; ++i) {
+      const int r = im.rgba[4 * i], g = im.rgba[4 * i + 1], bl = im.rgba[4 * i + 2];
+      red += r > 60 && r > 3 * g && r > 3 * bl;
+      *skin += r > 60 && r > bl + 20;
+    }
+    afm_image_free(&im);
+    return red;
+  };
+  int skin_rest = 0, skin_pushed = 0;
+  EXPECT_EQ(count(s.X0, "rest", &skin_rest), 0);
+  Eigen::MatrixXd X = s.X0;
+  for (int v = 0; v < s.n; ++v)
+    X.row(s.node(kEpidermis, v)) = 2 * s.X0.row(s.node(kDermis, v)) - s.X0.row(s.node(kEpidermis, v));
+  ASSERT_GT(turned_slabs(s, X).size(), static_cast<size_t>(s.F.rows() / 2));
+  const int red = count(X, "pushed", &skin_pushed);
+  EXPECT_GT(red, skin_pushed / 2) << "of " << skin_pushed << " warm pixels";
+  EXPECT_GT(skin_rest, 1000) << "the face fills the picture";
 }
 
 TEST(SkinModel, VolumeHessianMatchesFiniteDifferences) {
