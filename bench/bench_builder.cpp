@@ -35,6 +35,14 @@ constexpr int kComparedRuns = 3;
 
 // The collapse floor's modulus the bench weighs (afm-build --collapse-floor).
 constexpr double kBenchFloor = 0.3;
+// The collapse floor's modulus for the whole AFM: at 0.1 Song's targets keep
+// 1 of their 2,477 turned slabs (docs/anatomy.md, "Tissue").
+constexpr double kAfmFloor = 0.1;
+std::string short_number(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%g", v);
+  return b;
+}
 
 // The median off-axis share of a synthesis' FAP targets, percent.
 double off_median(const FapSynthesis &f) {
@@ -56,6 +64,7 @@ struct WholeAfm {
   double seconds = 0, targets_seconds = 0;  // the whole job; the targets alone
   size_t made = 0, tried = 0, under = 0;    // targets made, attempted, short of their reference
   double off = 0;                           // off-axis median, percent
+  long long slabs = 0;                      // slabs of tissue the solved poses turn (a hold once)
   Expected<std::vector<uint8_t>> bytes = Status::error("not built");
   SolveCounts work;  // the solver's, summed over every solve (afm-build --stats)
   // The model's solver options point here: it lives as long as the model.
@@ -80,7 +89,10 @@ WholeAfm whole_afm(const Scene &scene, const FdpSet &fdps, const FaceModelOption
     w.bytes = st.status();
     return w;
   }
-  for (const FapOutcome &o : st->outcomes) w.under += o.made && o.reached < 1;
+  for (const FapOutcome &o : st->outcomes) {
+    w.under += o.made && o.reached < 1;
+    if (o.made && !o.holds) w.slabs += o.slabs;
+  }
   w.made = st->targets.size(), w.tried = st->outcomes.size();
   w.off = off_median(*st);
   w.bytes = encode_afm(fap_afm_content(scene, fdps, w.model->model, std::move(*st)), AFM_PROFILE_DRACO);
@@ -156,23 +168,32 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
   // solves from rest (below) are another sample: newton-jacobi is faster at
   // them on Song, and 10 times slower at Song's whole AFM, whose solves
   // start from nearby poses and reuse their factorisations.
-  std::printf("%-16s %9s %7s %7s %6s %9s %9s %7s\n", "whole AFM", "seconds", "ratio", "made", "under", "off-axis",
-              "steps", "failed");
+  // Last, the default solver with the collapse floor (skin_model.h) at
+  // kAfmFloor: what keeping every slab of the targets' poses upright costs.
+  std::printf("%-16s %9s %7s %7s %6s %9s %9s %7s %7s\n", "whole AFM", "seconds", "ratio", "made", "under", "off-axis",
+              "steps", "failed", "slabs");
   const SolverKind default_kind = FaceModelOptions{}.solver.kind;
+  auto row = [&by_default](const std::string &name, const WholeAfm &w, const char *note) {
+    if (!w.bytes) {
+      std::printf("%-16s failed: %s\n", name.c_str(), w.bytes.status().message().c_str());
+      return;
+    }
+    // steps: Newton iterations or time steps over every solve; failed:
+    // solves; slabs: turned through themselves in the solved poses.
+    std::printf("%-16s %9.2f %6.1fx %3zu/%zu %6zu %8.1f%% %9lld %7lld %7lld%s\n", name.c_str(), w.seconds,
+                by_default.seconds > 0 ? w.seconds / by_default.seconds : 0.0, w.made, w.tried, w.under, w.off,
+                w.work.iterations, w.work.failed, w.slabs, note);
+  };
   for (SolverKind k : kSolverKinds) {
     FaceModelOptions fo;
     fo.solver.kind = k;
-    const WholeAfm other = k == default_kind ? WholeAfm{} : whole_afm(scene, fdps, fo);
-    const WholeAfm &w = k == default_kind ? by_default : other;
-    if (!w.bytes) {
-      std::printf("%-16s failed: %s\n", solver_name(k), w.bytes.status().message().c_str());
-      continue;
-    }
-    // steps: Newton iterations or time steps over every solve; failed: solves.
-    std::printf("%-16s %9.2f %6.1fx %3zu/%zu %6zu %8.1f%% %9lld %7lld%s\n", solver_name(k), w.seconds,
-                by_default.seconds > 0 ? w.seconds / by_default.seconds : 0.0, w.made, w.tried, w.under, w.off,
-                w.work.iterations, w.work.failed, k == default_kind ? "  (the default, above)" : "");
+    if (k == default_kind) row(solver_name(k), by_default, "  (the default, above)");
+    else row(solver_name(k), whole_afm(scene, fdps, fo), "");
   }
+  FaceModelOptions floored;
+  floored.tissue.collapse_modulus = kAfmFloor;
+  row(std::string(solver_name(default_kind)) + " floor " + short_number(kAfmFloor), whole_afm(scene, fdps, floored),
+      "");
 
   // Time to equilibrium at +100 % from rest, on V_d, factorisations included;
   // and the slabs of tissue the pose turns through themselves (skin_model.h,

@@ -217,9 +217,11 @@ Status write_fidelity_report(const std::string &dir, const Scene &scene, const F
   if (Status st = write_file_atomic(dir + sep + "report.txt", table); !st) return st;
   std::string csv =
       "kind,number,name,side,reference,reached,made,scale,prescribed_x,prescribed_y,prescribed_z,achieved_x,"
-      "achieved_y,achieved_z,along_error,off_axis,off_face,off_depth,largest,dynamic,turned,sunk,slabs,seconds,message\n";
+      "achieved_y,achieved_z,along_error,off_axis,off_face,off_depth,largest,dynamic,turned,sunk,slabs,seconds,"
+      "message\n";
   for (const FapOutcome &o : s.outcomes)
-    csv += format("%s,%d,%s,%d,%d,%.4g,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%d,%d,%.3f,",
+    csv += format("%s,%d,%s,%d,%d,%.4g,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%d,%d,"
+                  "%.3f,",
                   o.kind == AFM_TARGET_FAP ? "fap" : o.kind == AFM_TARGET_VISEME ? "viseme" : "expression",
                   o.number, csv_quote(target_label(o)).c_str(), o.side, o.reference, o.reached, o.made ? 1 : 0,
                   o.scale, o.prescribed.x(), o.prescribed.y(), o.prescribed.z(), o.achieved.x(), o.achieved.y(),
