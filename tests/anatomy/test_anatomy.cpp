@@ -18,10 +18,10 @@
 #include "anatomy/fdp_completion.h"
 #include "anatomy/muscle_table.h"
 #include "anatomy/sim_mesh.h"
-#include "render/anatomy_render.h"
 #include "io/load_face.h"
 #include "refhead/head_shape.h"
 #include "refhead/refhead.h"
+#include "render/anatomy_render.h"
 #include "../common/reference_model.h"
 #include "../common/test_paths.h"
 
@@ -367,8 +367,8 @@ TEST(SkinModel, TurnedSlabsFindsALayerPushedThroughItself) {
 }
 
 // `afm-build --pose` draws the skin red over the slabs a pose turns through
-// itself (render_pose_png): none at rest; with every epidermal node pushed
-// through the dermis, the skin it shows.
+// itself (render_pose_png): no red at rest; with every epidermal node pushed
+// through the dermis, most of the face red.
 TEST(SkinModel, ThePosePictureIsRedOverTheTurnedSlabsOnly) {
   const Built &b = head_1k();
   const SkinModel &s = b.model.tissue;
