@@ -54,7 +54,10 @@ std::vector<FapMapping> make_table() {
   // as a second group: mentalis alone took Song's 2.3 90 % of the way down
   // and turned 2 triangles; with the depressors it comes the whole way and
   // turns none (since the fifty-ninth session judged poses with their
-  // slivers untangled). On its sides (10, 11) they turned 2 each.
+  // slivers untangled). So do its sides (10, 11), each with its own side's
+  // depressor: mentalis alone took Song's 2.8 and 2.9 90 % of the way at
+  // four times its range, 32 % off-axis, the 2k head's 90 %, the 1k head's
+  // 99 %; with it all three the whole way, 5-8 % off-axis, none folding.
   for (int outer = 0; outer < 2; ++outer) {
     const int o = outer ? 47 : 0;  // 4 -> 51, 5 -> 52, ... 13 -> 60
     const char *io = outer ? "outer lip" : "inner lip";
@@ -95,6 +98,12 @@ std::vector<FapMapping> make_table() {
         lowered({{"mentalis_left", -100}}, {{"depressor_labii_left", 100}}), io);
     add(11 + o, D::Muscles, 350, {{"mentalis_right", 100}},
         lowered({{"mentalis_right", -100}}, {{"depressor_labii_right", 100}}), io);
+    if (!outer)
+      for (int k = 0; k < 2; ++k) {
+        const std::string side = k ? "right" : "left";
+        t[t.size() - 2 + static_cast<size_t>(k)].second_negative = {{"mentalis_" + side, -100},
+                                                                      {"depressor_labii_" + side, 100}};
+      }
     add(12 + o, D::Muscles, 150, {{"zygomaticus_major_left", 100}}, {{"depressor_anguli_left", 100}}, io);
     add(13 + o, D::Muscles, 150, {{"zygomaticus_major_right", 100}}, {{"depressor_anguli_right", 100}}, io);
   }

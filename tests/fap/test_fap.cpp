@@ -2765,6 +2765,17 @@ TEST(FapSynthesis, SongsInnerLowerLipComesDownToItsReferenceWithoutAFold) {
   EXPECT_EQ(expect_song_side_lowered(5, {5, 10, 11, 52, 57, 58}, 0.9), 1) << "the target at -350";
 }
 
+// Its left side lowered (FAP 10's negative side; streams send it to -870):
+// mentalis alone, driven backwards, took 2.8 90 % of the reference down at
+// four times its range, 32 % off the FAP's direction, and held it there;
+// its second group adds that side's depressor labii inferioris
+// (fap_mapping.cpp), and the side comes down the whole reference, about 8 %
+// off it, and folds none of the lifted skin.
+TEST(FapSynthesis, SongsInnerLowerLipSideComesDownToItsReferenceWithoutAFold) {
+  AFM_REQUIRE_SHARED_DATA();
+  EXPECT_EQ(expect_song_side_lowered(10, {5, 10, 11, 52, 57, 58}, 0.95), 1) << "the target at -350";
+}
+
 // Song's jaw, opened as FAP 3 says, on afm-build's simulation mesh: the
 // skin it stores turns no triangle, and the chin below 2.1 goes down with
 // it. Before, the jaw carried the skin down to 2.1 only, which Song's file
