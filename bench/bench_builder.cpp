@@ -36,7 +36,7 @@ constexpr int kComparedRuns = 3;
 // The collapse floor's modulus the bench weighs (afm-build --collapse-floor).
 constexpr double kBenchFloor = 0.3;
 // The collapse floor's modulus for the whole AFM: at 0.1 Song's targets keep
-// 1 of their 2,477 turned slabs (docs/anatomy.md, "Tissue").
+// 4 of their 2,467 turned slabs (docs/anatomy.md, "Tissue").
 constexpr double kAfmFloor = 0.1;
 std::string short_number(double v) {
   char b[32];
