@@ -38,11 +38,6 @@ constexpr double kBenchFloor = 0.3;
 // The collapse floor's modulus for the whole AFM: at 0.1 Song's targets keep
 // 4 of their 2,467 turned slabs (docs/anatomy.md, "Tissue").
 constexpr double kAfmFloor = 0.1;
-std::string short_number(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%g", v);
-  return b;
-}
 
 // The median off-axis share of a synthesis' FAP targets, percent.
 double off_median(const FapSynthesis &f) {
@@ -64,7 +59,7 @@ struct WholeAfm {
   double seconds = 0, targets_seconds = 0;  // the whole job; the targets alone
   size_t made = 0, tried = 0, under = 0;    // targets made, attempted, short of their reference
   double off = 0;                           // off-axis median, percent
-  long long slabs = 0;                      // slabs of tissue the solved poses turn (a hold once)
+  long long slabs = 0;                      // slabs of tissue the solved poses turn (solved_own_pose)
   Expected<std::vector<uint8_t>> bytes = Status::error("not built");
   SolveCounts work;  // the solver's, summed over every solve (afm-build --stats)
   // The model's solver options point here: it lives as long as the model.
@@ -91,7 +86,7 @@ WholeAfm whole_afm(const Scene &scene, const FdpSet &fdps, const FaceModelOption
   }
   for (const FapOutcome &o : st->outcomes) {
     w.under += o.made && o.reached < 1;
-    if (o.made && !o.holds) w.slabs += o.slabs;
+    if (solved_own_pose(o)) w.slabs += o.slabs;
   }
   w.made = st->targets.size(), w.tried = st->outcomes.size();
   w.off = off_median(*st);
@@ -192,8 +187,9 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
   }
   FaceModelOptions floored;
   floored.tissue.collapse_modulus = kAfmFloor;
-  row(std::string(solver_name(default_kind)) + " floor " + short_number(kAfmFloor), whole_afm(scene, fdps, floored),
-      "");
+  char floor_label[32];
+  std::snprintf(floor_label, sizeof floor_label, "%s floor %g", solver_name(default_kind), kAfmFloor);
+  row(floor_label, whole_afm(scene, fdps, floored), "");
 
   // Time to equilibrium at +100 % from rest, on V_d, factorisations included;
   // and the slabs of tissue the pose turns through themselves (skin_model.h,

@@ -57,7 +57,7 @@ std::vector<FapMapping> make_table() {
   // slivers untangled). So do its sides (10, 11), each with its own side's
   // depressor: mentalis alone took Song's 2.8 and 2.9 90 % of the way at
   // four times its range, 32 % off-axis, the 2k head's 90 %, the 1k head's
-  // 99 %; with it all three the whole way, 5-8 % off-axis, none folding.
+  // 99 %; with it all three the whole way, 4.5-8 % off-axis, none folding.
   for (int outer = 0; outer < 2; ++outer) {
     const int o = outer ? 47 : 0;  // 4 -> 51, 5 -> 52, ... 13 -> 60
     const char *io = outer ? "outer lip" : "inner lip";

@@ -315,6 +315,10 @@ bool solved_fap_target(const FapOutcome &o) {
   return o.made && o.kind == AFM_TARGET_FAP && !kinematic_fap(o.number) && !o.from_jaw;
 }
 
+bool solved_own_pose(const FapOutcome &o) {
+  return o.made && !o.holds && (o.kind != AFM_TARGET_FAP || solved_fap_target(o));
+}
+
 Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &model, const FapSynthesisOptions &options) {
   if (model.skin < 0 || model.tissue.n == 0) return Status::error("FAP synthesis: the model has no skin");
   const SkinModel &skin = model.tissue;

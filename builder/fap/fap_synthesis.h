@@ -221,6 +221,11 @@ struct FapOutcome {
 // FDP rule.
 bool solved_fap_target(const FapOutcome &o);
 
+// Whether a made outcome's pose is its own solve, counted once where a
+// synthesis sums what its poses do (FapOutcome::slabs): a solved FAP target,
+// a viseme or an expression; not a hold, which stores its reach's pose.
+bool solved_own_pose(const FapOutcome &o);
+
 struct FapSynthesisOptions {
   // What to make. All three empty: every mapped FAP, viseme and expression;
   // otherwise only those listed.

@@ -132,8 +132,7 @@ std::string fidelity_table(const FapSynthesis &s) {
     }
     if (o.turned > 0) ++turning, turned += o.turned;
     if (o.sunk > 0) ++sinking;
-    // A hold stores its reach's pose, extrapolated: counted once, with it.
-    if (!o.holds && !o.from_jaw && (o.kind != AFM_TARGET_FAP || solved_fap_target(o))) {
+    if (solved_own_pose(o)) {
       ++solved;
       if (o.slabs > 0) ++slab_turning, slabs += o.slabs;
     }
