@@ -164,18 +164,19 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
   // them on Song, and 10 times slower at Song's whole AFM, whose solves
   // start from nearby poses and reuse their factorisations.
   // Last, the default solver with the collapse floor (skin_model.h) at
-  // kAfmFloor: what keeping every slab of the targets' poses upright costs.
-  std::printf("%-16s %9s %7s %7s %6s %9s %9s %7s %7s\n", "whole AFM", "seconds", "ratio", "made", "under", "off-axis",
+  // kAfmFloor: what keeping every slab of the targets' poses upright costs;
+  // with the layered skin (afm-build --layered-skin), and with both.
+  std::printf("%-18s %9s %7s %7s %6s %9s %9s %7s %7s\n", "whole AFM", "seconds", "ratio", "made", "under", "off-axis",
               "steps", "failed", "slabs");
   const SolverKind default_kind = FaceModelOptions{}.solver.kind;
   auto row = [&by_default](const std::string &name, const WholeAfm &w, const char *note) {
     if (!w.bytes) {
-      std::printf("%-16s failed: %s\n", name.c_str(), w.bytes.status().message().c_str());
+      std::printf("%-18s failed: %s\n", name.c_str(), w.bytes.status().message().c_str());
       return;
     }
     // steps: Newton iterations or time steps over every solve; failed:
     // solves; slabs: turned through themselves in the solved poses.
-    std::printf("%-16s %9.2f %6.1fx %3zu/%zu %6zu %8.1f%% %9lld %7lld %7lld%s\n", name.c_str(), w.seconds,
+    std::printf("%-18s %9.2f %6.1fx %3zu/%zu %6zu %8.1f%% %9lld %7lld %7lld%s\n", name.c_str(), w.seconds,
                 by_default.seconds > 0 ? w.seconds / by_default.seconds : 0.0, w.made, w.tried, w.under, w.off,
                 w.work.iterations, w.work.failed, w.slabs, note);
   };
@@ -190,6 +191,13 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
   char floor_label[32];
   std::snprintf(floor_label, sizeof floor_label, "%s floor %g", solver_name(default_kind), kAfmFloor);
   row(floor_label, whole_afm(scene, fdps, floored), "");
+  FaceModelOptions layered;
+  layered.tissue.skin_load_share = kLayeredSkinLoadShare;
+  layered.tissue.layer_volume_modulus = kLayeredSkinVolumeModulus;
+  row("layered skin", whole_afm(scene, fdps, layered), "");
+  layered.tissue.collapse_modulus = kAfmFloor;
+  std::snprintf(floor_label, sizeof floor_label, "layered, floor %g", kAfmFloor);
+  row(floor_label, whole_afm(scene, fdps, layered), "");
 
   // Time to equilibrium at +100 % from rest, on V_d, factorisations included;
   // and the slabs of tissue the pose turns through themselves (skin_model.h,

@@ -25,18 +25,24 @@ Status missing(const MuscleDef &d, const std::vector<FdpId> &ids) {
   return Status::error(std::string("muscle ") + d.name + " needs FDP" + (ids.size() > 1 ? "s " : " ") + list);
 }
 
-// A dead load: force c w_i u_i on each influence node, u_i its direction at
-// rest (`direction` of the vertex and its node's rest position; zero: no
-// force); potential -c sum_i w_i (p_i - p0_i) . u_i.
+// A dead load: force c w_i u_i on each influence vertex, shared by the
+// layers it acts on, u_i its direction at rest (`direction` of the vertex
+// and each node's rest position; zero: no force); potential
+// -c sum_i w_i (p_i - p0_i) . u_i over those nodes, by their share.
 template <class Direction>
 double dead_load(const SkinModel &skin, const Muscle &m, double c, const Direction &direction,
                  const Eigen::MatrixXd &X, Eigen::MatrixXd *F) {
   double energy = 0;
+  // The layers that share it: a muscle inside the tissue it moves, the
+  // three evenly; a linear muscle, its force layer (the dermis) and the
+  // epidermis by TissueParams::skin_load_share; else its force layer.
   const bool whole = muscle_table()[static_cast<size_t>(m.def)].whole_thickness;
-  const int first = whole ? kEpidermis : m.force_layer, last = whole ? kHypodermis : m.force_layer;
-  const double share = 1.0 / (last - first + 1);
+  const double epidermis = !whole && m.kind == MuscleKind::Linear ? skin.params.skin_load_share : 0.0;
+  const int first = whole || epidermis > 0 ? kEpidermis : m.force_layer;
+  const int last = whole ? kHypodermis : m.force_layer;
   for (size_t i = 0; i < m.influence.size(); ++i)
     for (int layer = first; layer <= last; ++layer) {
+      const double share = whole ? 1.0 / 3 : layer == m.force_layer ? 1 - epidermis : epidermis;
       const int node = skin.node(layer, m.influence[i]);
       const Eigen::Vector3d x0 = skin.X0.row(node);
       const Eigen::Vector3d u = direction(m.influence[i], x0);

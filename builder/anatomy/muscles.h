@@ -87,7 +87,8 @@ struct Muscle {
   double area_a = 0, area_b = 0;  // the ellipse through the key points on the skin's
                                   // surface: equation 1's axes, and what pictures draw
   double width = 0;        // omega, or the sphincter's ellipse scale k
-  int force_layer = kDermis;  // kDermis (linear) or kHypodermis (sphincter); lid: 0..2
+  int force_layer = kDermis;  // kDermis (linear; TissueParams::skin_load_share of its load
+                              // goes on the epidermis), kHypodermis (sphincter); lid: 0..2
   // Lid: the eyeball (index into SkinModel::eyes; its centre is `epicentre`)
   // and the axis (+x or -x) the lid turns about as it closes.
   int eye = -1;

@@ -145,6 +145,9 @@ Expected<SkinModel> build_skin_model(const Scene &scene, int part, const TissueP
   if (!(params.collapse_modulus >= 0) || !(params.collapse_knee > 0 && params.collapse_knee <= 1))
     return Status::error("skin model: need collapse_modulus >= 0 and 0 < collapse_knee <= 1");
   if (!(params.lip_contact_modulus >= 0)) return Status::error("skin model: need lip_contact_modulus >= 0");
+  if (!(params.layer_volume_modulus >= 0)) return Status::error("skin model: need layer_volume_modulus >= 0");
+  if (!(params.skin_load_share >= 0 && params.skin_load_share <= 1))
+    return Status::error("skin model: need 0 <= skin_load_share <= 1");
 
   SkinModel m;
   m.part = part;

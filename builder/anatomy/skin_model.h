@@ -65,6 +65,16 @@ struct TissueParams {
   // chosen).
   double volume_modulus = 0.02;
   double shape_modulus = 0.1;
+  // Each layer's own volume (k_l; solver.h), off at 0: per slab that holds
+  // tissue (slab_holds_tissue), the volume term's form on the slab's own
+  // volume. The element's term lets one slab thin by as much as another
+  // thickens (docs/anatomy.md, "The layered skin"); 0.02 is k_v's value.
+  double layer_volume_modulus = 0.0;
+  // The epidermis's share of a linear muscle's load, 0..1, the rest on the
+  // dermis (muscles.h): the skin slab pulled on both its surfaces. 0: the
+  // dermis alone, which a pull drags under the epidermis, turning the skin's
+  // slab through its thickness (docs/anatomy.md, "The layered skin").
+  double skin_load_share = 0.0;
   // The collapse floor (solver.h), off at 0: a slab holding tissue
   // (slab_holds_tissue) squeezed below `collapse_knee` of its rest volume
   // has the energy collapse_modulus x its share of the element's nominal
@@ -78,6 +88,11 @@ struct TissueParams {
   double lip_contact_modulus = 1.0;
   double density = 1.0;        // mass per volume, for the lumped masses
 };
+
+// The layered skin (afm-build --layered-skin): the skin slab loaded on both
+// its surfaces, half each, and each layer's volume kept with k_v's modulus.
+constexpr double kLayeredSkinLoadShare = 0.5;
+constexpr double kLayeredSkinVolumeModulus = 0.02;
 
 enum class SpringKind : uint8_t { Layer, Connecting, Crossed };
 

@@ -39,6 +39,10 @@ struct Element {
   // slab's signed rest volume where it has a floor (0 elsewhere).
   double collapse[3];
   double slab_rest[3];
+  // Each layer's own volume term per slab: k_l / |V_s0|, 0 where the slab
+  // holds no tissue or the term is off; and the slab's signed rest volume.
+  double layer_weight[3];
+  double layer_rest[3];
 };
 
 // The collapse floor's profile psi(J) = ((j0 - J) / j0)^3 below the knee j0,
@@ -170,6 +174,11 @@ struct System {
                                ? m.params.collapse_modulus * slab_nominal_volume(m, f, sl)
                                : 0.0;
           e.slab_rest[sl] = e.collapse[sl] > 0 ? element_volume(m, m.X0, f, nullptr, sl) : 0.0;
+          e.layer_rest[sl] = element_volume(m, m.X0, f, nullptr, sl);
+          e.layer_weight[sl] = m.params.layer_volume_modulus > 0 && slab_holds_tissue(m, f, sl)
+                                       && e.layer_rest[sl] != 0
+                                   ? m.params.layer_volume_modulus / std::abs(e.layer_rest[sl])
+                                   : 0.0;
         }
         elements.push_back(e);
       }
@@ -386,7 +395,7 @@ void assemble(const System &sys, const Eigen::MatrixXd &X, const Eigen::MatrixXd
       add_tie(val, sys.tie_blocks[sys.springs.size() + i], B);
     }
   }
-  Eigen::Matrix<double, 9, 3> g, gs[3];
+  Eigen::Matrix<double, 9, 3> g, gs[3];  // gs: per slab
   VolumeHessian H;
   auto push = [&](const Element &el, double c, const Eigen::Matrix<double, 9, 3> &grad) {
     for (int k = 0; k < 9; ++k)
@@ -394,29 +403,47 @@ void assemble(const System &sys, const Eigen::MatrixXd &X, const Eigen::MatrixXd
   };
   for (size_t e = 0; e < sys.elements.size(); ++e) {
     const Element &el = sys.elements[e];
+    // With each layer's own volume, the slabs' volumes and gradients once;
+    // the element's are their sums.
+    const bool layered = el.layer_weight[0] > 0 || el.layer_weight[1] > 0 || el.layer_weight[2] > 0;
+    double vs[3] = {0, 0, 0};
+    if (layered) {
+      g.setZero();
+      for (int sl = 0; sl < 3; ++sl) {
+        vs[sl] = element_volume(m, X, el.f, &gs[sl], sl);
+        g += gs[sl];
+      }
+    }
     double excess = 0;  // k_v (V - V0) / |V0|: the weight of the volume's own curvature
     if (el.weight > 0) {
-      const double v = element_volume(m, X, el.f, &g);
+      const double v = layered ? vs[0] + vs[1] + vs[2] : element_volume(m, X, el.f, &g);
       if (r) push(el, -el.weight * (v - m.rest_volume[el.f]), g);
       if (K && curvature > 0) excess = curvature * el.weight * (v - m.rest_volume[el.f]);
       if (excess != 0) element_volume_hessian(m, X, el.f, &H);
     }
-    // Squeezed slabs: the floor's force, and its Gauss-Newton part
-    // w psi''(J) / V0^2 grad grad^T in both tangents. Its own curvature
-    // w psi'(J) / V0 d2V/dp2 is left out of the full one too: with it the
-    // full tangent turned indefinite more often (Song's AFM at k_c = 0.3:
-    // 2,816 factorisations against 2,030).
-    int squeezed = 0;
-    double gauss[3];
+    // Per slab, along its volume's gradient: the floor's force where it is
+    // squeezed, and the layer's own volume term's; their Gauss-Newton parts
+    // c grad grad^T in both tangents, the floor's w psi''(J) / V0^2 and the
+    // layer's k_l / |V_s0|. The slab volume's own curvature is left out:
+    // with the floor's w psi'(J) / V0 d2V/dp2 the full tangent turned
+    // indefinite more often (Song's AFM at k_c = 0.3: 2,816 factorisations
+    // against 2,030).
+    double gauss[3] = {0, 0, 0};
     for (int sl = 0; sl < 3; ++sl) {
-      if (el.collapse[sl] <= 0) continue;
-      const double v0 = el.slab_rest[sl];
-      const FloorValue p = slab_floor(m, X, el, sl);
-      const bool pushes = r && p.d1 != 0, stiffens = K && p.d2 > 0;
-      if (!pushes && !stiffens) continue;
-      element_volume(m, X, el.f, &gs[squeezed], sl);
-      if (pushes) push(el, -el.collapse[sl] * p.d1 / v0, gs[squeezed]);
-      if (stiffens) gauss[squeezed++] = el.collapse[sl] * p.d2 / (v0 * v0);
+      double force = 0;
+      if (el.collapse[sl] > 0) {
+        const double v0 = el.slab_rest[sl];
+        const FloorValue p = layered ? collapse_floor(vs[sl] / v0, m.params.collapse_knee) : slab_floor(m, X, el, sl);
+        force -= el.collapse[sl] * p.d1 / v0;
+        if (K && p.d2 > 0) gauss[sl] += el.collapse[sl] * p.d2 / (v0 * v0);
+      }
+      if (el.layer_weight[sl] > 0) {
+        force -= el.layer_weight[sl] * (vs[sl] - el.layer_rest[sl]);
+        if (K) gauss[sl] += el.layer_weight[sl];
+      }
+      if ((!r || force == 0) && gauss[sl] == 0) continue;
+      if (!layered) element_volume(m, X, el.f, &gs[sl], sl);
+      if (r && force != 0) push(el, force, gs[sl]);
     }
     if (r && el.shape > 0) {
       Eigen::Vector3d mean = Eigen::Vector3d::Zero();
@@ -437,7 +464,10 @@ void assemble(const System &sys, const Eigen::MatrixXd &X, const Eigen::MatrixXd
         if (b.base < 0 && bt.base < 0) continue;
         Eigen::Matrix3d B = Eigen::Matrix3d::Identity() * (el.shape * ((i == j ? 1.0 : 0.0) - 1.0 / 12.0));
         if (el.weight > 0) B.noalias() += el.weight * g.row(i).transpose() * g.row(j);
-        for (int q = 0; q < squeezed; ++q) B.noalias() += gauss[q] * gs[q].row(i).transpose() * gs[q].row(j);
+        // Slab sl's gradient has rows 3 sl .. 3 sl + 5 only.
+        for (int sl = 0; sl < 3; ++sl)
+          if (gauss[sl] != 0 && i >= 3 * sl && j < 3 * sl + 6)
+            B.noalias() += gauss[sl] * gs[sl].row(i).transpose() * gs[sl].row(j);
         if (excess != 0 && i != j) {
           // excess * H.block(i, j), i < j, written out: the call and its
           // 3 x 3 temporary were 13 % of assemble() (perf, Song's AFM).
@@ -513,12 +543,23 @@ double total_energy(const System &sys, const ForceField &forces, const Eigen::Ma
     e += lip_contact_energy(p, X(p.upper, 1) - X(p.lower, 1)).e;
   }
   for (const Element &el : sys.elements) {
+    const bool layered = el.layer_weight[0] > 0 || el.layer_weight[1] > 0 || el.layer_weight[2] > 0;
+    double vs[3] = {0, 0, 0};
+    if (layered)
+      for (int sl = 0; sl < 3; ++sl) vs[sl] = element_volume(m, X, el.f, nullptr, sl);
     if (el.weight > 0) {
-      const double dv = element_volume(m, X, el.f) - m.rest_volume[el.f];
+      const double dv = (layered ? vs[0] + vs[1] + vs[2] : element_volume(m, X, el.f)) - m.rest_volume[el.f];
       e += 0.5 * el.weight * dv * dv;
     }
-    for (int sl = 0; sl < 3; ++sl)
-      if (el.collapse[sl] > 0) e += el.collapse[sl] * slab_floor(m, X, el, sl).e;
+    for (int sl = 0; sl < 3; ++sl) {
+      if (el.collapse[sl] > 0)
+        e += el.collapse[sl] * (layered ? collapse_floor(vs[sl] / el.slab_rest[sl], m.params.collapse_knee)
+                                        : slab_floor(m, X, el, sl)).e;
+      if (el.layer_weight[sl] > 0) {
+        const double dv = vs[sl] - el.layer_rest[sl];
+        e += 0.5 * el.layer_weight[sl] * dv * dv;
+      }
+    }
     if (el.shape > 0) {
       Eigen::Matrix<double, 12, 3> d;
       for (int k = 0; k < 12; ++k) d.row(k) = X.row(el.global[k]) - ref.row(el.global[k]);

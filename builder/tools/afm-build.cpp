@@ -50,6 +50,11 @@ void usage(FILE *out) {
       "                          rest volume (modulus K, e.g. 0.3; default 0: off), so\n"
       "                          that none turns through itself; slower, and the lips\n"
       "                          move differently (docs/anatomy.md, \"Tissue\")\n"
+      "  --layered-skin          linear muscles pull the skin on both its surfaces\n"
+      "                          (epidermis and dermis, half each) and each layer\n"
+      "                          keeps its own volume: far fewer slabs turn through\n"
+      "                          themselves, but every target moves and some reach\n"
+      "                          less (docs/anatomy.md, \"The layered skin\")\n"
       "  --sim-vertices N|full   simulate on a coarser copy of the skin of about N\n"
       "                          vertices (its own, every skin FDP among them; finer\n"
       "                          around eyes and mouth; mirror-symmetric where the\n"
@@ -227,6 +232,9 @@ int main(int argc, char **argv) {
       if (k.empty() || *end || !(v >= 0 && v <= 100))
         return usage_error("--collapse-floor '" + k + "': use a modulus, 0..100 (0: off)");
       fo.tissue.collapse_modulus = v;
+    } else if (a == "--layered-skin") {
+      fo.tissue.skin_load_share = kLayeredSkinLoadShare;
+      fo.tissue.layer_volume_modulus = kLayeredSkinVolumeModulus;
     } else if (a == "--threads") {
       const std::string t = value("--threads");
       char *end = nullptr;
