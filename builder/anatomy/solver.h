@@ -26,6 +26,10 @@
 //             the element's nominal volume. Its tangent is the Gauss-Newton
 //             part k_c V_nom,s psi''(J) / V_s0^2 dV_s/dp dV_s/dp^T only,
 //             in both forms;
+//   layers    off unless TissueParams::layer_volume_modulus k_l > 0: per
+//             slab s that holds tissue, E_l = k_l (V_s - V_s0)^2 / (2 |V_s0|),
+//             force -k_l (V_s - V_s0) / |V_s0| dV_s/dp, and its Gauss-Newton
+//             part k_l / |V_s0| dV_s/dp dV_s/dp^T in both forms;
 //             The tangent above is the full one. Its "projected" form drops
 //             the compressed springs' negative T / l and the volume's
 //             second-order part, and is positive semi-definite everywhere.

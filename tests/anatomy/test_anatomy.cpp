@@ -941,6 +941,60 @@ TEST(Physics, WithTheCollapseFloorNoSlabTurnsAtTheFullRange) {
   std::printf("with the floor, %zu poses at the full range: %zu slabs turned\n", poses.size(), turned);
 }
 
+// Each layer's own volume (TissueParams::layer_volume_modulus, solver.h):
+// what it adds to the residual is minus the gradient of its energy, the sum
+// over slabs that hold tissue of k_l (V_s - V_s0)^2 / (2 |V_s0|), here from
+// element_volume by central differences; and it pushes back dermis nodes
+// moved toward the epidermis, which thin the skin's slab by about what they
+// thicken the fat's (the element's own volume barely changes).
+TEST(SkinModel, EachLayersVolumeTermIsTheGradientOfItsEnergy) {
+  const FaceModel &m = head_1k().model;
+  const SkinModel &s = m.tissue;
+  SkinModel l = s;
+  const double k = 0.02;
+  l.params.layer_volume_modulus = k;
+  const Eigen::Vector3d c = m.fdps.find(*FdpId::parse("5.1"))->pos;  // the left cheek
+  Eigen::MatrixXd X = s.X0;
+  std::vector<int> moved_nodes;
+  for (int v = 0; v < s.n; ++v) {
+    if (!s.in_mesh[static_cast<size_t>(v)] || (s.X0.row(v).transpose() - c).norm() > 0.025) continue;
+    const int d = s.node(kDermis, v);
+    X.row(d) += (s.X0.row(v) - s.X0.row(d)) / 3;
+    moved_nodes.push_back(d);
+  }
+  ASSERT_GE(moved_nodes.size(), 10u);
+  auto energy = [&](const Eigen::MatrixXd &P) {
+    double e = 0;
+    for (int f = 0; f < s.F.rows(); ++f)
+      for (int sl = 0; sl < 3; ++sl) {
+        if (!slab_holds_tissue(s, f, sl)) continue;
+        const double v0 = element_volume(s, s.X0, f, nullptr, sl), dv = element_volume(s, P, f, nullptr, sl) - v0;
+        e += 0.5 * k * dv * dv / std::abs(v0);
+      }
+    return e;
+  };
+  const std::vector<int> all = all_vertices(s);
+  const Eigen::MatrixXd added = residual_forces(l, all, ForceField{}, s.X0, X) - residual_forces(s, all, ForceField{}, s.X0, X);
+  int back = 0;
+  double worst = 0;
+  for (size_t i = 0; i < moved_nodes.size(); ++i) {
+    const int node = moved_nodes[i];
+    if ((s.X0.row(node) - X.row(node)).dot(added.row(node)) > 0) ++back;
+    if (i % 3) continue;  // central differences on a third of them
+    for (int a = 0; a < 3; ++a) {
+      const double h = 1e-6;
+      Eigen::MatrixXd P = X, M = X;
+      P(node, a) += h, M(node, a) -= h;
+      const double fd = -(energy(P) - energy(M)) / (2 * h);
+      worst = std::max(worst, std::abs(added(node, a) - fd) / (added.row(node).norm() + 1e-30));
+    }
+  }
+  std::printf("each layer's volume: %d of %zu moved dermis nodes pushed back; the force against central "
+              "differences %.2g of its size at worst\n", back, moved_nodes.size(), worst);
+  EXPECT_LT(worst, 1e-4);
+  EXPECT_EQ(back, static_cast<int>(moved_nodes.size()));
+}
+
 // The layered skin (TissueParams::skin_load_share, layer_volume_modulus;
 // docs/anatomy.md): a linear muscle's load goes on the epidermal and the
 // dermal node of each influence vertex by the share, of the magnitude the
