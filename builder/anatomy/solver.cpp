@@ -34,15 +34,14 @@ struct Element {
   int global[12]; // the element's nodes, layers 0-3
   double weight;  // volume term: k_v / |V0|, 0 for an element seen edge-on
   double shape;   // shape term: k_s V_nom / R^2 (R: radius of gyration at rest)
-  // Collapse floor per slab: k_c x the slab's share of V_nom, 0 where it has
-  // none (off, or a slab that holds no tissue: slab_holds_tissue), and the
-  // slab's signed rest volume where it has a floor (0 elsewhere).
+  // Per slab: the collapse floor, k_c x the slab's share of V_nom, and each
+  // layer's own volume term, k_l / |V_s0|; 0 where off or where the slab
+  // holds no tissue (slab_holds_tissue). The slab's signed rest volume where
+  // either is on (0 elsewhere), and whether any slab has a layer term.
   double collapse[3];
-  double slab_rest[3];
-  // Each layer's own volume term per slab: k_l / |V_s0|, 0 where the slab
-  // holds no tissue or the term is off; and the slab's signed rest volume.
   double layer_weight[3];
-  double layer_rest[3];
+  double slab_rest[3];
+  bool layered;
 };
 
 // The collapse floor's profile psi(J) = ((j0 - J) / j0)^3 below the knee j0,
@@ -169,16 +168,18 @@ struct System {
         for (int k = 0; k < 12; ++k) p.row(k) = m.X0.row(e.global[k]);
         const double gyration2 = (p.rowwise() - p.colwise().mean()).squaredNorm() / 12.0;
         e.shape = gyration2 > 0 ? m.params.shape_modulus * m.nominal_volume[f] / gyration2 : 0.0;
+        e.layered = false;
         for (int sl = 0; sl < 3; ++sl) {
-          e.collapse[sl] = m.params.collapse_modulus > 0 && slab_holds_tissue(m, f, sl)
+          const bool holds = (m.params.collapse_modulus > 0 || m.params.layer_volume_modulus > 0) &&
+                             slab_holds_tissue(m, f, sl);
+          e.slab_rest[sl] = holds ? element_volume(m, m.X0, f, nullptr, sl) : 0.0;
+          e.collapse[sl] = holds && m.params.collapse_modulus > 0
                                ? m.params.collapse_modulus * slab_nominal_volume(m, f, sl)
                                : 0.0;
-          e.slab_rest[sl] = e.collapse[sl] > 0 ? element_volume(m, m.X0, f, nullptr, sl) : 0.0;
-          e.layer_rest[sl] = element_volume(m, m.X0, f, nullptr, sl);
-          e.layer_weight[sl] = m.params.layer_volume_modulus > 0 && slab_holds_tissue(m, f, sl)
-                                       && e.layer_rest[sl] != 0
-                                   ? m.params.layer_volume_modulus / std::abs(e.layer_rest[sl])
+          e.layer_weight[sl] = holds && m.params.layer_volume_modulus > 0 && e.slab_rest[sl] != 0
+                                   ? m.params.layer_volume_modulus / std::abs(e.slab_rest[sl])
                                    : 0.0;
+          e.layered = e.layered || e.layer_weight[sl] > 0;
         }
         elements.push_back(e);
       }
@@ -405,7 +406,7 @@ void assemble(const System &sys, const Eigen::MatrixXd &X, const Eigen::MatrixXd
     const Element &el = sys.elements[e];
     // With each layer's own volume, the slabs' volumes and gradients once;
     // the element's are their sums.
-    const bool layered = el.layer_weight[0] > 0 || el.layer_weight[1] > 0 || el.layer_weight[2] > 0;
+    const bool layered = el.layered;
     double vs[3] = {0, 0, 0};
     if (layered) {
       g.setZero();
@@ -438,7 +439,7 @@ void assemble(const System &sys, const Eigen::MatrixXd &X, const Eigen::MatrixXd
         if (K && p.d2 > 0) gauss[sl] += el.collapse[sl] * p.d2 / (v0 * v0);
       }
       if (el.layer_weight[sl] > 0) {
-        force -= el.layer_weight[sl] * (vs[sl] - el.layer_rest[sl]);
+        force -= el.layer_weight[sl] * (vs[sl] - el.slab_rest[sl]);
         if (K) gauss[sl] += el.layer_weight[sl];
       }
       if ((!r || force == 0) && gauss[sl] == 0) continue;
@@ -543,7 +544,7 @@ double total_energy(const System &sys, const ForceField &forces, const Eigen::Ma
     e += lip_contact_energy(p, X(p.upper, 1) - X(p.lower, 1)).e;
   }
   for (const Element &el : sys.elements) {
-    const bool layered = el.layer_weight[0] > 0 || el.layer_weight[1] > 0 || el.layer_weight[2] > 0;
+    const bool layered = el.layered;
     double vs[3] = {0, 0, 0};
     if (layered)
       for (int sl = 0; sl < 3; ++sl) vs[sl] = element_volume(m, X, el.f, nullptr, sl);
@@ -556,7 +557,7 @@ double total_energy(const System &sys, const ForceField &forces, const Eigen::Ma
         e += el.collapse[sl] * (layered ? collapse_floor(vs[sl] / el.slab_rest[sl], m.params.collapse_knee)
                                         : slab_floor(m, X, el, sl)).e;
       if (el.layer_weight[sl] > 0) {
-        const double dv = vs[sl] - el.layer_rest[sl];
+        const double dv = vs[sl] - el.slab_rest[sl];
         e += 0.5 * el.layer_weight[sl] * dv * dv;
       }
     }
