@@ -33,11 +33,6 @@ namespace {
 const char *kCompared[] = {"zygomaticus_major_left", "corrugator_left", "orbicularis_oris"};
 constexpr int kComparedRuns = 3;
 
-// The collapse floor's modulus the bench weighs (afm-build --collapse-floor).
-constexpr double kBenchFloor = 0.3;
-// The collapse floor's modulus for the whole AFM: at 0.1 Song's targets keep
-// 4 of their 2,467 turned slabs (docs/anatomy.md, "Tissue").
-constexpr double kAfmFloor = 0.1;
 
 // The median off-axis share of a synthesis' FAP targets, percent.
 double off_median(const FapSynthesis &f) {
@@ -163,20 +158,21 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
   // solves from rest (below) are another sample: newton-jacobi is faster at
   // them on Song, and 10 times slower at Song's whole AFM, whose solves
   // start from nearby poses and reuse their factorisations.
-  // Last, the default solver with the collapse floor (skin_model.h) at
-  // kAfmFloor: what keeping every slab of the targets' poses upright costs;
-  // with the layered skin (afm-build --layered-skin), and with both.
-  std::printf("%-18s %9s %7s %7s %6s %9s %9s %7s %7s\n", "whole AFM", "seconds", "ratio", "made", "under", "off-axis",
+  // Last, the default solver on other tissue (skin_model.h): without the
+  // layered skin and the collapse floor (unlayered_tissue, the tissue before
+  // them), with the floor alone, and with the layered skin alone: what
+  // keeping every slab of the targets' poses upright costs.
+  std::printf("%-20s %9s %7s %7s %6s %9s %9s %7s %7s\n", "whole AFM", "seconds", "ratio", "made", "under", "off-axis",
               "steps", "failed", "slabs");
   const SolverKind default_kind = FaceModelOptions{}.solver.kind;
   auto row = [&by_default](const std::string &name, const WholeAfm &w, const char *note) {
     if (!w.bytes) {
-      std::printf("%-18s failed: %s\n", name.c_str(), w.bytes.status().message().c_str());
+      std::printf("%-20s failed: %s\n", name.c_str(), w.bytes.status().message().c_str());
       return;
     }
     // steps: Newton iterations or time steps over every solve; failed:
     // solves; slabs: turned through themselves in the solved poses.
-    std::printf("%-18s %9.2f %6.1fx %3zu/%zu %6zu %8.1f%% %9lld %7lld %7lld%s\n", name.c_str(), w.seconds,
+    std::printf("%-20s %9.2f %6.1fx %3zu/%zu %6zu %8.1f%% %9lld %7lld %7lld%s\n", name.c_str(), w.seconds,
                 by_default.seconds > 0 ? w.seconds / by_default.seconds : 0.0, w.made, w.tried, w.under, w.off,
                 w.work.iterations, w.work.failed, w.slabs, note);
   };
@@ -186,23 +182,21 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
     if (k == default_kind) row(solver_name(k), by_default, "  (the default, above)");
     else row(solver_name(k), whole_afm(scene, fdps, fo), "");
   }
-  FaceModelOptions floored;
-  floored.tissue.collapse_modulus = kAfmFloor;
-  char floor_label[32];
-  std::snprintf(floor_label, sizeof floor_label, "%s floor %g", solver_name(default_kind), kAfmFloor);
-  row(floor_label, whole_afm(scene, fdps, floored), "");
-  FaceModelOptions layered;
-  layered.tissue.skin_load_share = kLayeredSkinLoadShare;
-  layered.tissue.layer_volume_modulus = kLayeredSkinVolumeModulus;
-  row("layered skin", whole_afm(scene, fdps, layered), "");
-  layered.tissue.collapse_modulus = kAfmFloor;
-  std::snprintf(floor_label, sizeof floor_label, "layered, floor %g", kAfmFloor);
-  row(floor_label, whole_afm(scene, fdps, layered), "");
+  FaceModelOptions variant;
+  variant.tissue = unlayered_tissue();
+  row("unlayered", whole_afm(scene, fdps, variant), "  (no floor)");
+  variant.tissue.collapse_modulus = kCollapseFloor;
+  char floored[32];
+  std::snprintf(floored, sizeof floored, "unlayered, floor %g", kCollapseFloor);
+  row(floored, whole_afm(scene, fdps, variant), "");
+  variant.tissue = TissueParams{};
+  variant.tissue.collapse_modulus = 0;
+  row("layered, no floor", whole_afm(scene, fdps, variant), "");
 
   // Time to equilibrium at +100 % from rest, on V_d, factorisations included;
   // and the slabs of tissue the pose turns through themselves (skin_model.h,
-  // turned_slabs), which the default tissue does not prevent (the collapse
-  // floor, weighed at the end, does).
+  // turned_slabs), which the default tissue prevents (against the tissue
+  // before it at the end).
   std::printf("%-24s %6s %8s %6s %6s %6s %7s\n", "muscle (+100 %)", "V_d", "seconds", "iters", "CG", "fact",
               "turned");
   double sum = 0;
@@ -354,10 +348,11 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
                 solver_name(m->solver.kind), n[0], n[1], change(n[0], n[1]), failed[0], failed[1]);
   }
 
-  // The collapse floor (skin_model.h, TissueParams::collapse_modulus): every
-  // muscle at its calibrated +100 % tension on its set, without and with it.
+  // The default tissue against the one before the layered skin and the
+  // collapse floor (skin_model.h, unlayered_tissue): every muscle at its
+  // calibrated +100 % tension on its set.
   FaceModelOptions floor_options;
-  floor_options.tissue.collapse_modulus = kBenchFloor;
+  floor_options.tissue = unlayered_tissue();
   floor_options.calibrate = false;
   Expected<FaceModel> mf = build_face_model(scene, fdps, floor_options);
   if (!mf) {
@@ -376,9 +371,9 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
       floor_turned[s] += turned_slabs((s == 0 ? *m : *mf).tissue, X[s]).size();
     }
   }
-  std::printf("collapse floor %.1f, every muscle at +100 %%: slabs turned %zu -> %zu, iterations %d -> %d (%+.0f %%)%s\n",
-              kBenchFloor, floor_turned[0], floor_turned[1], floor_its[0], floor_its[1],
-              change(floor_its[0], floor_its[1]),
+  std::printf("unlayered -> default tissue, every muscle at +100 %%: slabs turned %zu -> %zu, iterations %d -> %d "
+              "(%+.0f %%)%s\n",
+              floor_turned[1], floor_turned[0], floor_its[1], floor_its[0], change(floor_its[1], floor_its[0]),
               floor_failed ? (", " + std::to_string(floor_failed) + " did not converge").c_str() : "");
   return true;
 }

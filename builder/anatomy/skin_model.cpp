@@ -133,6 +133,13 @@ std::vector<int8_t> near_eyeballs(const Eigen::MatrixXd &V, const std::vector<ui
   return out;
 }
 
+TissueParams unlayered_tissue(TissueParams p) {
+  p.skin_load_share = 0;
+  p.layer_volume_modulus = 0;
+  p.collapse_modulus = 0;
+  return p;
+}
+
 Expected<SkinModel> build_skin_model(const Scene &scene, int part, const TissueParams &params) {
   if (part < 0 || part >= static_cast<int>(scene.parts.size()))
     return Status::error("skin model: no skin part");

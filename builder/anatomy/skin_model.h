@@ -50,6 +50,14 @@ struct SlabParams {
   double ratio;    // stiffness beyond the knee / below it
 };
 
+// The defaults (docs/anatomy.md, "The layered skin"): the skin slab loaded
+// on both its surfaces, half each; each layer's volume kept with k_v's
+// modulus; the collapse floor at a third of the modulus that keeps every
+// slab upright without the layers.
+constexpr double kLayeredSkinLoadShare = 0.5;
+constexpr double kLayeredSkinVolumeModulus = 0.02;
+constexpr double kCollapseFloor = 0.1;
+
 struct TissueParams {
   double skull_scale = 0.9;       // s: skull = c + s (p0 - c); tissue is (1 - s) |p0 - c| thick
   double dermis_depth = 0.2;      // depth of layer 1, fraction of the epidermis-to-skull line
@@ -65,23 +73,23 @@ struct TissueParams {
   // chosen).
   double volume_modulus = 0.02;
   double shape_modulus = 0.1;
-  // Each layer's own volume (k_l; solver.h), off at 0: per slab that holds
+  // Each layer's own volume (k_l; solver.h), 0: off: per slab that holds
   // tissue (slab_holds_tissue), the volume term's form on the slab's own
-  // volume. The element's term lets one slab thin by as much as another
-  // thickens (docs/anatomy.md, "The layered skin"); 0.02 is k_v's value.
-  double layer_volume_modulus = 0.0;
+  // volume. The element's term alone lets one slab thin by as much as
+  // another thickens (docs/anatomy.md, "The layered skin").
+  double layer_volume_modulus = kLayeredSkinVolumeModulus;
   // The epidermis's share of a linear muscle's load, 0..1, the rest on the
   // dermis (muscles.h): the skin slab pulled on both its surfaces. 0: the
   // dermis alone, which a pull drags under the epidermis, turning the skin's
   // slab through its thickness (docs/anatomy.md, "The layered skin").
-  double skin_load_share = 0.0;
-  // The collapse floor (solver.h), off at 0: a slab holding tissue
+  double skin_load_share = kLayeredSkinLoadShare;
+  // The collapse floor (solver.h), 0: off: a slab holding tissue
   // (slab_holds_tissue) squeezed below `collapse_knee` of its rest volume
   // has the energy collapse_modulus x its share of the element's nominal
   // volume x ((knee - J) / knee)^3, J its volume over its rest volume, so
-  // that no slab turns through itself (0.3: none at +100 % of any muscle
-  // on the generated heads and Song; docs/anatomy.md gives the cost).
-  double collapse_modulus = 0.0;
+  // that no slab turns through itself (with the layered skin, none in
+  // Song's or the 10k head's targets; docs/anatomy.md gives the cost).
+  double collapse_modulus = kCollapseFloor;
   double collapse_knee = 0.5;
   // Lip-lip contact (lip_contact.h): the contact pressure at a crossing of
   // one margin, relative like the slabs' moduli; 0: off.
@@ -89,10 +97,12 @@ struct TissueParams {
   double density = 1.0;        // mass per volume, for the lumped masses
 };
 
-// The layered skin (afm-build --layered-skin): the skin slab loaded on both
-// its surfaces, half each, and each layer's volume kept with k_v's modulus.
-constexpr double kLayeredSkinLoadShare = 0.5;
-constexpr double kLayeredSkinVolumeModulus = 0.02;
+// The tissue before the layered skin and the floor (afm-build
+// --no-layered-skin --collapse-floor 0): linear muscles on the dermis alone,
+// one volume term per element, no floor. Strong pulls turn slabs through
+// themselves there; kept to compare with, and for the tests whose case is
+// such a slab.
+TissueParams unlayered_tissue(TissueParams p = {});
 
 enum class SpringKind : uint8_t { Layer, Connecting, Crossed };
 

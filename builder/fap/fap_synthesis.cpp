@@ -1618,11 +1618,12 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       if (u.moved > 0) {
         for (const SkinBinding &b : carried) t.displacement[static_cast<size_t>(b.part)] = Eigen::MatrixXd();
         carry(D, t);
-        char what[224];
+        char what[288], near[64] = "";
+        if (u.near_before > 0) std::snprintf(near, sizeof near, " and %d slivers nearly turned", u.near_before);
         std::snprintf(what, sizeof what,
-                      "untangled %d of %d turned triangles: %d vertices move (in patches, each affinely "
+                      "untangled %d of %d turned triangles%s: %d vertices move (in patches, each affinely "
                       "or as one piece, or as a sliver's corner), changed by %.2g at most",
-                      u.turned_before - u.turned_after, u.turned_before, u.moved, u.largest_change);
+                      u.turned_before - u.turned_after, u.turned_before, near, u.moved, u.largest_change);
         r.outcome.message += std::string(r.outcome.message.empty() ? "" : "; ") + what;
       }
       const SkinFaults faults = skin_faults(model, rest + D);

@@ -11,16 +11,38 @@ namespace afmb {
 Untangled untangle(const Eigen::MatrixXd &V0, const Eigen::MatrixXi &F, const std::vector<char> &hold,
                    const SimMesh *sim, Eigen::MatrixXd &D) {
   const bool lifted = sim && sim->decimated;
-  std::vector<int> coarse, fine;  // the turned triangles of the last count
+  std::vector<int> coarse, fine;  // the triangles to untangle of the last count
   const RestFaces rest = rest_faces(V0, F);
+  // The slivers that count as turned when nearly edge-on (untangle.h).
+  std::vector<int> slivers;
+  const double mean = rest.total / std::max<double>(1, static_cast<double>(F.rows()));
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    if (rest.length(f) > 1e-3 * mean && rest.length(f) < kNearTurnArea * mean) slivers.push_back(static_cast<int>(f));
+  int turned = 0;  // of the last count: those really turned, the nearly turned left out
   auto count = [&](const Eigen::MatrixXd &E) {
-    coarse = turned_faces(rest, F, V0 + E);
+    const Eigen::MatrixXd V = V0 + E;
+    coarse = turned_faces(rest, F, V);
     fine = lifted ? lifted_turned_faces(*sim, E) : std::vector<int>();
+    turned = static_cast<int>(coarse.size() + fine.size());
+    for (int f : slivers) {
+      const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
+      const Eigen::Vector3d n = (b - a).cross(c - a);
+      const double along = rest.normal[static_cast<size_t>(f)].dot(n);
+      if (along > 0 && along < kNearTurnCos * rest.length(f) * n.norm()) coarse.push_back(f);
+    }
     return static_cast<int>(coarse.size() + fine.size());
   };
+  // Rounds compare by the triangles really turned, then by all counted.
+  int best_total = count(D);
   Untangled out;
-  out.turned_before = out.turned_after = count(D);
-  if (out.turned_before == 0) return out;
+  out.turned_before = out.turned_after = turned;
+  out.near_before = best_total - turned;
+  if (best_total == 0) return out;
+  auto better = [&](int total) {
+    if (turned > out.turned_after || (turned == out.turned_after && total >= best_total)) return false;
+    out.turned_after = turned, best_total = total;
+    return true;
+  };
 
   // Patches: a union-find over the vertices; `rigid` and `pinned` per root.
   const size_t n = static_cast<size_t>(V0.rows());
@@ -58,7 +80,7 @@ Untangled untangle(const Eigen::MatrixXd &V0, const Eigen::MatrixXi &F, const st
   const Eigen::MatrixXd original = D;
   Eigen::MatrixXd best = D;
   std::vector<int> c;
-  for (int round = 0; round < kUntangleMaxRounds && out.turned_after > 0; ++round) {
+  for (int round = 0; round < kUntangleMaxRounds && best_total > 0; ++round) {
     // A triangle that turns inside a patch (all it stands for in one) makes
     // that patch move as one piece; then every turned triangle joins one.
     for (bool is_fine : {false, true})
@@ -102,13 +124,12 @@ Untangled untangle(const Eigen::MatrixXd &V0, const Eigen::MatrixXi &F, const st
       const Eigen::MatrixXd fit = X * W;
       for (Eigen::Index i = 0; i < m; ++i) D.row(p[static_cast<size_t>(i)]) = fit.row(i);
     }
-    const int now = count(D);
-    if (now < out.turned_after) out.turned_after = now, best = D;
+    if (better(count(D))) best = D;
   }
   D = std::move(best);
   // The slivers still turned: an apex to its foot's motion (untangle.h),
   // kept where fewer triangles turn, until no apex helps.
-  bool any = out.turned_after > 0;
+  bool any = best_total > 0;
   while (any) {
     any = false;
     count(D);
@@ -127,8 +148,8 @@ Untangled untangle(const Eigen::MatrixXd &V0, const Eigen::MatrixXi &F, const st
       if ((foot - D.row(apex)).squaredNorm() > kSliverShare * kSliverShare * longest) continue;
       const Eigen::RowVector3d was = D.row(apex);
       D.row(apex) = foot;
-      if (const int now = count(D); now < out.turned_after)
-        out.turned_after = now, any = true;
+      if (better(count(D)))
+        any = true;
       else
         D.row(apex) = was;
     }

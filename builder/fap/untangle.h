@@ -39,6 +39,15 @@
 // it and stays) are evened out in the split's weights before
 // (fap_partition.h).
 //
+// A sliver (under kNearTurnArea of the skin's mean triangle) that a target
+// turns nearly edge-on (the cosine of its normal with its rest normal below
+// kNearTurnCos) is untangled as if turned, though not counted as turned:
+// another target added to it turns it. Song's mouth corners, where the jaw
+// opened turned some a few degrees short of edge-on, turned in the Xface
+// streams that add the jaw's thrust to its opening (joy.fap's frame 24,
+// FAPs 3 at 314 and 14 at 31). A larger triangle that far turned is the
+// skin rolling (a lip curled), and stays as solved.
+//
 // On a simulation mesh (`sim` decimated), what is stored is the lifted
 // skin (sim_mesh.h), so its turned triangles count too: each stands for
 // the coarse vertices its corners are bound to.
@@ -53,6 +62,8 @@ namespace afmb {
 
 constexpr int kUntangleMaxRounds = 32;  // then it gives up, keeping the best round
 constexpr double kSliverShare = 0.25;    // the most a sliver's apex moves, of its longest edge
+constexpr double kNearTurnArea = 0.02;   // a sliver: under this share of the mean triangle's area
+constexpr double kNearTurnCos = 0.3;     // nearly edge-on: turned more than 72.5 degrees from its rest facing
 
 // What untangle() may do with a vertex's motion.
 enum UntangleHold : char {
@@ -62,8 +73,9 @@ enum UntangleHold : char {
 };
 
 struct Untangled {
-  int turned_before = 0;  // turned triangles before (coarse plus lifted)
+  int turned_before = 0;  // turned triangles before (coarse plus lifted; nearly turned slivers not counted)
   int turned_after = 0;   // after: 0 unless it gave up or a held or fixed vertex holds a fold
+  int near_before = 0;    // nearly turned slivers before (untangled as if turned)
   int moved = 0;          // vertices whose displacement changed (patches, apices)
   double largest_change = 0;  // the largest change of a vertex's displacement, model units
 };

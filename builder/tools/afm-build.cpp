@@ -47,14 +47,16 @@ void usage(FILE *out) {
       "                          paper's scheme) or newton-jacobi (solver.h; calibration\n"
       "                          always runs a newton solver)\n"
       "  --collapse-floor K      resist each slab of tissue squeezed below half its\n"
-      "                          rest volume (modulus K, e.g. 0.3; default 0: off), so\n"
-      "                          that none turns through itself; slower, and the lips\n"
-      "                          move differently (docs/anatomy.md, \"Tissue\")\n"
-      "  --layered-skin          linear muscles pull the skin on both its surfaces\n"
-      "                          (epidermis and dermis, half each) and each layer\n"
-      "                          keeps its own volume: far fewer slabs turn through\n"
-      "                          themselves, but every target moves and some reach\n"
-      "                          less (docs/anatomy.md, \"The layered skin\")\n"
+      "                          rest volume with modulus K (default %g; 0: off), so\n"
+      "                          that none turns through itself (docs/anatomy.md,\n"
+      "                          \"Tissue\")\n"
+      "  --no-layered-skin       the skin before the layered skin: linear muscles pull\n"
+      "                          the dermis alone and only each element keeps its\n"
+      "                          volume (by default the epidermis and the dermis take\n"
+      "                          half the pull each and each layer keeps its own;\n"
+      "                          docs/anatomy.md, \"The layered skin\"); with\n"
+      "                          --collapse-floor 0, strong pulls turn slabs through\n"
+      "                          themselves\n"
       "  --sim-vertices N|full   simulate on a coarser copy of the skin of about N\n"
       "                          vertices (its own, every skin FDP among them; finer\n"
       "                          around eyes and mouth; mirror-symmetric where the\n"
@@ -147,7 +149,7 @@ void usage(FILE *out) {
       "\n"
       "Exit status: 0 on success (FAPs that cannot be made are reported, not fatal), 1\n"
       "on bad input, an output that cannot be written or a solve that does not\n"
-      "converge (the message says which and why), 2 on bad usage.\n", kDefaultSimVertices, kMaxFapScale);
+      "converge (the message says which and why), 2 on bad usage.\n", kCollapseFloor, kDefaultSimVertices, kMaxFapScale);
 }
 
 bool stderr_is_terminal() {
@@ -232,9 +234,9 @@ int main(int argc, char **argv) {
       if (k.empty() || *end || !(v >= 0 && v <= 100))
         return usage_error("--collapse-floor '" + k + "': use a modulus, 0..100 (0: off)");
       fo.tissue.collapse_modulus = v;
-    } else if (a == "--layered-skin") {
-      fo.tissue.skin_load_share = kLayeredSkinLoadShare;
-      fo.tissue.layer_volume_modulus = kLayeredSkinVolumeModulus;
+    } else if (a == "--no-layered-skin") {
+      fo.tissue.skin_load_share = 0;
+      fo.tissue.layer_volume_modulus = 0;
     } else if (a == "--threads") {
       const std::string t = value("--threads");
       char *end = nullptr;

@@ -6,7 +6,8 @@
 
 namespace afmtest {
 
-SongOnSimMesh song_on_sim_mesh(const std::vector<std::string> &muscles, bool jaw, int vertices) {
+SongOnSimMesh song_on_sim_mesh(const std::vector<std::string> &muscles, bool jaw, int vertices,
+                               const afmb::TissueParams &tissue) {
   SongOnSimMesh out;
   afmb::Expected<afmb::LoadedFace> f = afmb::load_face(
       shared_data("faces/song/song.WRL"), shared_data("faces/song/song.fdp"), afmb::LoadOptions{}, nullptr);
@@ -14,6 +15,7 @@ SongOnSimMesh song_on_sim_mesh(const std::vector<std::string> &muscles, bool jaw
   if (!f.is_ok()) return out;
   out.face = std::move(*f);
   afmb::FaceModelOptions fo;
+  fo.tissue = tissue;
   fo.calibrate_only = muscles;
   fo.calibrate_muscles = !muscles.empty();
   fo.calibrate_jaw = jaw;

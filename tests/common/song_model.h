@@ -11,9 +11,9 @@
 
 namespace afmtest {
 
-// Song on a simulation mesh of `vertices` (afm-build's default), with only
-// `muscles` calibrated (none when empty) and the jaw when `jaw`; the loaded
-// face (its whole skin) beside it.
+// Song on a simulation mesh of `vertices` (afm-build's default), of
+// `tissue`, with only `muscles` calibrated (none when empty) and the jaw
+// when `jaw`; the loaded face (its whole skin) beside it.
 struct SongOnSimMesh {
   afmb::LoadedFace face;
   afmb::SimFaceModel built;
@@ -22,6 +22,6 @@ struct SongOnSimMesh {
 // Records a test failure (and leaves `built` empty) when Song does not load
 // or build.
 SongOnSimMesh song_on_sim_mesh(const std::vector<std::string> &muscles, bool jaw = false,
-                               int vertices = afmb::kDefaultSimVertices);
+                               int vertices = afmb::kDefaultSimVertices, const afmb::TissueParams &tissue = {});
 
 }  // namespace afmtest

@@ -1114,16 +1114,23 @@ TEST(FapSynthesis, WhereTheLidsMeetShortOfAnInBetweenItIsMadeWhereTheyMeet) {
 // The 1k head's lower lid driver reaches its range (FAP 21 at 300) but its
 // load takes the lid only 82 % of the way to the in-between at 600; there
 // the lid turned as a whole makes it, exact at its FDP by the MPEG-4 rule,
-// with no skin turned over or in the eyeball.
+// with no skin turned over or in the eyeball. On the tissue before the
+// layered skin (unlayered_tissue): on the default one the driver makes 600.
 TEST(FapSynthesis, AnInBetweenTheLidDriverFallsShortOfIsMadeByTurningTheLid) {
-  const Built &b = head_1k();
+  FapSynthesisOptions o;
+  o.only = {21};
+  o.negative_sides = false;
+  FaceModelOptions fo;
+  fo.tissue = unlayered_tissue();
+  fo.calibrate_only = calibration_needs(o).muscles;
+  fo.calibrate_jaw = false;
+  const std::unique_ptr<Built> built = afmtest::build_reference_model(1000, fo);
+  ASSERT_TRUE(built);
+  const Built &b = *built;
   const FaceModel &m = b.model;
   const int lower = m.find("palpebral_lower_left");
   ASSERT_GE(lower, 0);
   ASSERT_EQ(m.muscles[static_cast<size_t>(lower)].range_max, 1) << "the driver reaches the table's range";
-  FapSynthesisOptions o;
-  o.only = {21};
-  o.negative_sides = false;
   Expected<FapSynthesis> syn = synthesize_faps(b.head.scene, m, o);
   ASSERT_TRUE(syn.is_ok()) << syn.status().message();
   std::map<int, std::pair<const FapOutcome *, const MorphTarget *>> by;  // reference
@@ -1456,6 +1463,53 @@ TEST(Untangle, AHeldSliversApexTakesItsFootsMotionAndAFixedOneStays) {
   EXPECT_EQ(E, D);
 }
 
+// untangle()'s nearly turned slivers (untangle.h): a sliver (a hundredth of
+// the mean triangle's area) lifted at its apex until it stands nearly
+// edge-on (its normal at a cosine of 0.1 with its rest one), turned by
+// nothing, is untangled as if turned: its corners, a patch of three, move
+// as one piece, and it lies flat again; the count of turned triangles stays
+// 0. The same rotation of a triangle that is no sliver (half the mesh's
+// mean area) is the skin rolling, and stays as solved.
+TEST(Untangle, ANearlyTurnedSliverIsUntangledAndALargerTriangleIsNot) {
+  for (const double apex : {0.005, 0.5}) {
+    Eigen::MatrixXd V(5, 3);
+    V << 0, 0, 0,  // a
+        2, 0, 0,   // b
+        1, apex, 0,  // c: the apex, above ab
+        1, 1.5, 0,   // d
+        1, -1, 0;    // e
+    Eigen::MatrixXi F(4, 3);
+    F << 0, 1, 2, 0, 2, 3, 2, 1, 3, 0, 4, 1;
+    ASSERT_TRUE(turned_faces(V, F, V).empty());
+    const double area = apex, mean = (2.0 * 1.5 / 2 + 2.0 * 1 / 2) / 4;  // abc's area; abc + acd + cbd = abd
+    // Lift c until abc's normal (0, -2h, 2 apex) is at a cosine of 0.1 with z.
+    const double h = apex * std::sqrt(99.0);
+    Eigen::MatrixXd D = Eigen::MatrixXd::Zero(5, 3);
+    D(2, 2) = h;
+    auto facing = [&V](const Eigen::MatrixXd &M) {  // abc's unit normal's z, moved by M
+      const Eigen::Vector3d a = V.row(0) + M.row(0), b = V.row(1) + M.row(1), c = V.row(2) + M.row(2);
+      return (b - a).cross(c - a).normalized().z();
+    };
+    ASSERT_NEAR(facing(D), 0.1, 1e-12);
+    ASSERT_TRUE(turned_faces(V, F, V + D).empty());
+    Eigen::MatrixXd E = D;
+    const Untangled u = untangle(V, F, {}, nullptr, E);
+    EXPECT_EQ(u.turned_before, 0);
+    EXPECT_EQ(u.turned_after, 0);
+    if (area < kNearTurnArea * mean) {
+      EXPECT_EQ(u.near_before, 1);
+      EXPECT_EQ(u.moved, 3) << "a, b and c";
+      EXPECT_NEAR(facing(E), 1.0, 1e-12) << "the sliver lies flat";
+      for (int v = 0; v < 3; ++v) EXPECT_TRUE(E.row(v).isApprox(Eigen::RowVector3d(0, 0, h / 3))) << E;
+      EXPECT_EQ(E.bottomRows(2), D.bottomRows(2));
+    } else {
+      EXPECT_EQ(u.near_before, 0);
+      EXPECT_EQ(u.moved, 0);
+      EXPECT_EQ(E, D);
+    }
+  }
+}
+
 // Groups too weak within their calibrated range pass it (their tensions
 // extrapolated) up to kMaxFapScale: frontalis lowering the brow (FAP 33's
 // negative side) does, and its target still meets the MPEG-4 rule
@@ -1478,9 +1532,10 @@ TEST(FapSynthesis, AWeakGroupPassesItsRangeUpToTheCap) {
 // A group whose pose at the reference, beyond its range, folds the skin
 // stops short of the fold, at a scale whose pose keeps the skin a face:
 // the zygomatici lifting the 1k head's left cheek (FAP 41, without its
-// helpers) reach 70 % of the reference at 1.7 times their range (the FDP
-// 1.7 times as far as at the range) and fold the skin where they reach all
-// of it. Stored once, at the reference (no hold).
+// helpers) reach 65 % of the reference at 1.35 times their range (the FDP
+// 1.39 times as far as at the range; 70 % and 1.7 times on the tissue before
+// the layered skin) and fold the skin where they reach all of it. Stored
+// once, at the reference (no hold).
 TEST(FapSynthesis, AGroupThatFoldsBeyondItsRangeStopsShortOfTheFold) {
   const Built &b = head_1k();
   const FaceModel &m = b.model;
@@ -1519,7 +1574,7 @@ TEST(FapSynthesis, AGroupThatFoldsBeyondItsRangeStopsShortOfTheFold) {
   Expected<Pose> at_one = solve_pose(m, a, &cache);
   ASSERT_TRUE(at_one.is_ok()) << at_one.status().message();
   const double along_one = action(at_one->X, nullptr), along = D.row(fdp->vertex).dot(dir.transpose());
-  EXPECT_GT(along, 1.5 * along_one);
+  EXPECT_GT(along, 1.25 * along_one);
   const double value = find_fap_mapping(41)->reference * fapu_distance(m.fapu, info->unit) / 1024.0;
   EXPECT_LT(along, value);
   SteerFrom from;
@@ -1840,9 +1895,12 @@ TEST(FapSynthesis, AModelCalibratedOnlyForItsTargetsMakesTheSameTargets) {
 // Mirror twins (fap_synthesis.h). The reference head is mirror-symmetric,
 // so FAP 13 (the right corner raised) is made from FAP 12's recipe, one
 // solve from its pose mirrored, on both sides. Each is the target the whole
-// search and steering make on the same model without its mirror, within a
-// quantum (0.5 and 0.01), and the mirror image of FAP 12's within 1 % of
-// its largest motion (1.3 and 2.3 quanta of 660-760); and FAP 13 listed
+// search and steering make on the same model without its mirror, within two
+// quanta (0.7 and 1.9; 0.5 and 0.01 on the tissue before the layered skin
+// and the floor, whose solves' last steps are shorter: each solve stops
+// within its tolerance, half a quantum, by solver.h's estimate), and the
+// mirror image of FAP 12's within 1 % of its largest motion (2.2 and 1.7
+// quanta of 640-690); and FAP 13 listed
 // alone, or on one worker (it then waits for no twin), is made from its
 // twin all the same, bit for bit.
 TEST(FapSynthesis, ARightFapIsMadeFromItsLeftTwinAsTheWholeSearchMakesIt) {
@@ -1897,7 +1955,7 @@ TEST(FapSynthesis, ARightFapIsMadeFromItsLeftTwinAsTheWholeSearchMakesIt) {
     std::printf("  side %+d: %.3f quanta from FAP 12's image, %.3f from the searched target (largest motion %.1f quanta)\n",
                 side, from_image / m.quantum, from_search / m.quantum, D13.rowwise().norm().maxCoeff() / m.quantum);
     EXPECT_LT(from_image, 0.01 * D13.rowwise().norm().maxCoeff()) << side;
-    EXPECT_LT(from_search, m.quantum) << side;
+    EXPECT_LT(from_search, 2 * m.quantum) << side;
     // The FDP rule holds as for any target.
     const FapOutcome &out = twins->outcomes[r];
     EXPECT_LT(out.along_error, 0.02) << side;
@@ -2617,12 +2675,14 @@ int expect_only_the_lifted_skin_folds(const SongOnSimMesh &song, const LiftedSid
 // Given the simulation mesh, the synthesis stops short of that fold as it
 // does of a coarse one (fap_synthesis.h). (Until the lips got drivers of
 // their own, FAP 16's negative side, pursing by orbicularis oris, showed it.)
+// On the tissue before the layered skin and the floor (unlayered_tissue):
+// on the default one the corners drawn in fold neither skin.
 TEST(FapSynthesis, ATargetMadeOnASimulationMeshDoesNotFoldTheLiftedSkin) {
   AFM_REQUIRE_SHARED_DATA();
   // On an 800-vertex mesh: on afm-build's 1,000, decimated in mirror pairs
   // since the thirty-fourth session, none of Song's mouth FAPs folds the
   // lifted skin and not the coarse one.
-  const SongOnSimMesh song = song_on_sim_mesh({"orbicularis_oris"}, false, 800);
+  const SongOnSimMesh song = song_on_sim_mesh({"orbicularis_oris"}, false, 800, unlayered_tissue());
   ASSERT_FALSE(HasFailure());
   ASSERT_TRUE(song.built.sim.decimated);
   FapSynthesisOptions o;
@@ -2648,12 +2708,14 @@ TEST(FapSynthesis, ATargetMadeOnASimulationMeshDoesNotFoldTheLiftedSkin) {
 // lifted skin as stored, untangled (fap_synthesis.h): the side reaches its
 // reference as it does blind to the lifted skin, and the skin it stores
 // turns none. Judged by the raw slivers, it stopped at 88 % (fifty-ninth
-// session).
+// session). On the tissue before the layered skin and the floor
+// (unlayered_tissue): on the default one the lifted skin stays whole.
 TEST(FapSynthesis, ALiftedSliverTheUntanglingStraightensDoesNotStopASide) {
   AFM_REQUIRE_SHARED_DATA();
   FapSynthesisOptions o;
   o.only = {52};
-  const SongOnSimMesh song = song_on_sim_mesh(calibration_needs(o).muscles);
+  const SongOnSimMesh song = song_on_sim_mesh(calibration_needs(o).muscles, false, kDefaultSimVertices,
+                                              unlayered_tissue());
   ASSERT_FALSE(HasFailure());
   ASSERT_TRUE(song.built.sim.decimated);
   const LiftedSide blind = negative_side_lifted(song.built, o, nullptr),
@@ -2837,11 +2899,12 @@ TEST(FapSynthesis, SongsOpeningJawTakesItsChinAlongAndTurnsNoTriangle) {
 }
 
 // Joy on the generated 3k head, simulated on 1,500 vertices, folds the
-// cheeks over where the zygomatici act. Only the muscles to blame are
-// reduced: risorius, the eye sphincters and the jaw keep the table's
-// contraction, and the target is that pose. (Until zygomaticus major pulled
-// along the skin's surface, 0.093 % of the skin's area turned, 0.048 %
-// after, and the eye sphincters were blamed too.)
+// cheek over where zygomaticus major acts. Only the muscle to blame is
+// reduced: zygomaticus minor, risorius, the eye sphincters and the jaw keep
+// the table's contraction, and the target is that pose. (Until zygomaticus
+// major pulled along the skin's surface, 0.093 % of the skin's area turned,
+// 0.048 % after, and the eye sphincters were blamed too; on the tissue
+// before the layered skin, both zygomatici were to blame.)
 // (This was the 2k head on 1,000 vertices until the generator got lid rows;
 // no expression of the 1k or 2k heads on 1,000 simulation vertices, or of
 // Song, tears now.)
@@ -2864,8 +2927,7 @@ TEST(HighLevel, AnExpressionThatTearsTheSkinReducesTheMusclesThatTearIt) {
   ASSERT_EQ(syn->outcomes.size(), 1u);
   const FapOutcome &out = syn->outcomes[0];
   ASSERT_TRUE(out.made) << out.message;
-  EXPECT_NE(out.message.find(": zygomaticus_major, zygomaticus_minor at "), std::string::npos)
-      << out.message;
+  EXPECT_NE(out.message.find(": zygomaticus_major at "), std::string::npos) << out.message;
   EXPECT_GT(out.scale, 0.0);
   EXPECT_LT(out.scale, 1.0);
   ASSERT_EQ(syn->targets.size(), 1u);
@@ -2889,7 +2951,7 @@ TEST(HighLevel, AnExpressionThatTearsTheSkinReducesTheMusclesThatTearIt) {
   auto pose = [&](bool reduce) {
     Activation a;
     for (const FapContraction &k : h->muscles) {
-      const bool blamed = k.muscle.rfind("zygomaticus", 0) == 0;
+      const bool blamed = k.muscle.rfind("zygomaticus_major", 0) == 0;  // left and right
       a.muscles.push_back({m.find(k.muscle), k.percent * (reduce && blamed ? out.scale : 1.0)});
     }
     a.jaw_open = 0.5 * (lo + hi);
@@ -2909,7 +2971,8 @@ TEST(HighLevel, AnExpressionThatTearsTheSkinReducesTheMusclesThatTearIt) {
   // them by the eye sphincters, the lower lids have two equilibria, and the
   // start picks one, 29 quanta (0.14 mm) apart at a lower-lid vertex, 9 at
   // the skin beside it (measured on the 2k head; a solver tolerance ten
-  // times finer gives the same two poses). On the 3k head: 24 quanta.
+  // times finer gives the same two poses). On the 3k head: 24 quanta on the
+  // tissue before the layered skin, 0.2 on the default one.
   const double apart = (D - reduced).rowwise().norm().maxCoeff();
   const double table_apart = (table - reduced).rowwise().norm().maxCoeff();
   EXPECT_LT(apart, 40 * m.quantum);
