@@ -33,7 +33,6 @@ namespace {
 const char *kCompared[] = {"zygomaticus_major_left", "corrugator_left", "orbicularis_oris"};
 constexpr int kComparedRuns = 3;
 
-
 // The median off-axis share of a synthesis' FAP targets, percent.
 double off_median(const FapSynthesis &f) {
   std::vector<double> off;

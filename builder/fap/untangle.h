@@ -42,11 +42,12 @@
 // A sliver (under kNearTurnArea of the skin's mean triangle) that a target
 // turns nearly edge-on (the cosine of its normal with its rest normal below
 // kNearTurnCos) is untangled as if turned, though not counted as turned:
-// another target added to it turns it. Song's mouth corners, where the jaw
-// opened turned some a few degrees short of edge-on, turned in the Xface
-// streams that add the jaw's thrust to its opening (joy.fap's frame 24,
+// another target added to it turns it. The jaw's opening left slivers at
+// Song's left mouth corner 5-13 degrees short of edge-on, and the Xface
+// streams that add the jaw's thrust to it turned them (joy.fap's frame 24,
 // FAPs 3 at 314 and 14 at 31). A larger triangle that far turned is the
-// skin rolling (a lip curled), and stays as solved.
+// skin rolling (a lip curled), and stays as solved. (The coarse skin's
+// slivers: the lifted skin's count when turned.)
 //
 // On a simulation mesh (`sim` decimated), what is stored is the lifted
 // skin (sim_mesh.h), so its turned triangles count too: each stands for
