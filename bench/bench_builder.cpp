@@ -350,30 +350,30 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
   // The default tissue against the one before the layered skin and the
   // collapse floor (skin_model.h, unlayered_tissue): every muscle at its
   // calibrated +100 % tension on its set.
-  FaceModelOptions floor_options;
-  floor_options.tissue = unlayered_tissue();
-  floor_options.calibrate = false;
-  Expected<FaceModel> mf = build_face_model(scene, fdps, floor_options);
-  if (!mf) {
-    std::printf("floor build failed: %s\n", mf.status().message().c_str());
+  FaceModelOptions unlayered_options;
+  unlayered_options.tissue = unlayered_tissue();
+  unlayered_options.calibrate = false;
+  Expected<FaceModel> unlayered = build_face_model(scene, fdps, unlayered_options);
+  if (!unlayered) {
+    std::printf("unlayered build failed: %s\n", unlayered.status().message().c_str());
     return false;
   }
-  int floor_its[2] = {0, 0}, floor_failed = 0;
-  size_t floor_turned[2] = {0, 0};
+  int tissue_its[2] = {0, 0}, tissue_failed = 0;
+  size_t tissue_slabs[2] = {0, 0};
   for (const Muscle &mu : m->muscles) {
     SolveStats st[2];
     Eigen::MatrixXd X[2];
-    solve_pair(*mf, mu, m->solver.kind, st, X);
+    solve_pair(*unlayered, mu, m->solver.kind, st, X);
     for (int s = 0; s < 2; ++s) {
-      floor_its[s] += st[s].iterations;
-      floor_failed += !st[s].converged;
-      floor_turned[s] += turned_slabs((s == 0 ? *m : *mf).tissue, X[s]).size();
+      tissue_its[s] += st[s].iterations;
+      tissue_failed += !st[s].converged;
+      tissue_slabs[s] += turned_slabs((s == 0 ? *m : *unlayered).tissue, X[s]).size();
     }
   }
-  std::printf("unlayered -> default tissue, every muscle at +100 %%: slabs turned %zu -> %zu, iterations %d -> %d "
-              "(%+.0f %%)%s\n",
-              floor_turned[1], floor_turned[0], floor_its[1], floor_its[0], change(floor_its[1], floor_its[0]),
-              floor_failed ? (", " + std::to_string(floor_failed) + " did not converge").c_str() : "");
+  std::printf("unlayered -> default tissue, every muscle at +100 %%: slabs turned %zu -> %zu, "
+              "iterations %d -> %d (%+.0f %%)%s\n",
+              tissue_slabs[1], tissue_slabs[0], tissue_its[1], tissue_its[0], change(tissue_its[1], tissue_its[0]),
+              tissue_failed ? (", " + std::to_string(tissue_failed) + " did not converge").c_str() : "");
   return true;
 }
 

@@ -924,8 +924,7 @@ TEST(Physics, TheCollapseFloorKeepsEverySlabUpright) {
 // calibrated range turns no slab on the 1k head on the default tissue (the
 // layered skin and the floor at kCollapseFloor), and with the floor at 0.3
 // neither does the jaw wide open (56 slabs turn over these poses on the
-// tissue before the layers and the floor; the default's jaw turns 5, below
-// the chin, where its followers bend).
+// tissue before the layers and the floor; the default's jaw turns 5).
 TEST(Physics, NoSlabTurnsAtTheFullRange) {
   for (double floor : {kCollapseFloor, 0.3}) {
     FaceModelOptions fo;
@@ -1569,8 +1568,7 @@ TEST(Physics, PosesStartedFromTheCalibratedPosesAddedAreTheSameEquilibria) {
   // sphere only to rounding, and is free until a step pushes it in (3
   // iterations since lid nodes are held up to their rest distance, 1
   // before). The jaw takes 9 on the default tissue, its pose 0.05 quanta
-  // from the start (2 without the collapse floor, 12 with it at 0.3): the
-  // floor's cubic grows fast where the jaw squeezes slabs below the chin.
+  // from the start (2 without the collapse floor, 12 with it at 0.3).
   Activation one, open;
   one.muscles = {{zyg, 100.0}};
   open.jaw_open = 100;
@@ -1941,8 +1939,7 @@ TEST(Solver, LongerStepsCutTheCrawlOnAStiffSkin) {
   // they reach the same equilibrium in fewer iterations (19 -> 13 when
   // this was written; switched off, the last check fails). On the tissue
   // before the layered skin and the floor (unlayered_tissue), where this was
-  // measured: on the default one the two solves end 8 quanta apart, on a
-  // flat equilibrium.
+  // measured: on the default one the two solves end 8 quanta apart.
   const Built &b = head_1k();
   FaceModelOptions fo;
   fo.calibrate = false;
