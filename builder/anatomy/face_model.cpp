@@ -450,9 +450,15 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
       if (s) m.dynamic = std::move(*set);  // grown by both sides: V_d
       result[k] = s;
     } else {
+      // The jaw's calibrated full opening, by a newton solver like the
+      // muscles' calibrations: every pose that opens the jaw starts from it.
       Activation open;
       open.jaw_open = 100;
-      jaw_pose = solve_pose(model, open, &cache);
+      SolverOptions newton = model.solver;
+      if (newton.kind == SolverKind::ImplicitEuler) newton.kind = SolverKind::Newton;
+      PoseOptions po;
+      po.solver = &newton;
+      jaw_pose = solve_pose(model, open, &cache, po);
     }
     std::lock_guard<std::mutex> g(lock);
     progress(++finished, total, what);

@@ -14,12 +14,16 @@
 //
 // Calibration (section 3.3): each side is one equilibrium solve with the
 // tension as an unknown (solver.h, load control), so the key node's action
-// is exact to the solver tolerance. On a mirror-symmetric skin
-// (FaceModel::mirror) a right muscle whose left twin is calibrated too
-// waits for it and starts from the twin's calibrated poses mirrored, at its
-// tensions, on its set joined with the twin's V_d mirrored (Song: mostly 2 to 7
-// Newton iterations a side instead of 4 to 14; the calibrations' CPU 2.7 ->
-// 2.2 s).
+// is exact to the solver tolerance. It runs a newton solver whatever
+// FaceModelOptions::solver says (implicit-euler cannot solve for a
+// tension), and so does the jaw's calibrated full opening
+// (Jaw::open_response), which every pose that opens the jaw starts from:
+// implicit-euler found no equilibrium for it on Song within its 2,000
+// steps. On a mirror-symmetric skin (FaceModel::mirror) a right muscle
+// whose left twin is calibrated too waits for it and starts from the twin's
+// calibrated poses mirrored, at its tensions, on its set joined with the
+// twin's V_d mirrored (Song: mostly 2 to 7 Newton iterations a side instead
+// of 4 to 14; the calibrations' CPU 2.7 -> 2.2 s).
 //
 // Dynamic node sets (section 3.2.4): every solve runs on a set of skin
 // vertices; the rest stay exactly where they are. A muscle's set V_d starts
