@@ -223,6 +223,16 @@ Eigen::MatrixXd carried_rest(const FaceModel &model, const Eigen::Affine3d &jaw)
   return X;
 }
 
+// The model's solver options for the calibrations (the muscles' sides and
+// the jaw's full opening): a newton solver whatever the model's, since
+// implicit-euler cannot solve for a tension and, on Song, found no
+// equilibrium for the jaw within its 2,000 steps (face_model.h).
+SolverOptions calibration_solver(const FaceModel &model) {
+  SolverOptions opts = model.solver;
+  if (opts.kind == SolverKind::ImplicitEuler) opts.kind = SolverKind::Newton;
+  return opts;
+}
+
 // Finds the tension giving the +100 % (maximum) or -100 % action (section
 // 3.3): one equilibrium solve with the tension as an unknown (solver.h, load
 // control), on `set`, grown while the wave reaches its border.
@@ -240,8 +250,7 @@ Status calibrate_side(const FaceModel &model, Muscle &m, bool maximum, FactorCac
   control.unit_load = unit_load(model, m, maximum ? 1.0 : -1.0);
   control.action = [&](const Eigen::MatrixXd &X, Eigen::MatrixXd *g) { return muscle_action(model.tissue, m, X, g); };
   control.value = muscle_action_target(m, maximum);
-  SolverOptions opts = model.solver;
-  if (opts.kind == SolverKind::ImplicitEuler) opts.kind = SolverKind::Newton;  // it cannot solve for a tension
+  const SolverOptions opts = calibration_solver(model);
   Eigen::MatrixXd X = model.tissue.X0;
   if (twin && (maximum ? twin->range_max == m.range_max : twin->range_min == m.range_min)) {
     Activation a;
@@ -450,12 +459,11 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
       if (s) m.dynamic = std::move(*set);  // grown by both sides: V_d
       result[k] = s;
     } else {
-      // The jaw's calibrated full opening, by a newton solver like the
-      // muscles' calibrations: every pose that opens the jaw starts from it.
+      // The jaw's calibrated full opening, which every pose that opens the
+      // jaw starts from.
       Activation open;
       open.jaw_open = 100;
-      SolverOptions newton = model.solver;
-      if (newton.kind == SolverKind::ImplicitEuler) newton.kind = SolverKind::Newton;
+      const SolverOptions newton = calibration_solver(model);
       PoseOptions po;
       po.solver = &newton;
       jaw_pose = solve_pose(model, open, &cache, po);

@@ -1464,8 +1464,8 @@ TEST(Untangle, AHeldSliversApexTakesItsFootsMotionAndAFixedOneStays) {
 }
 
 // untangle()'s nearly turned slivers (untangle.h): a sliver (under a
-// hundredth of the mean triangle's area) lifted at its apex until it stands nearly
-// edge-on (its normal at a cosine of 0.1 with its rest one), turned by
+// hundredth of the mean triangle's area) lifted at its apex until it stands
+// nearly edge-on (its normal at a cosine of 0.1 with its rest one), turned by
 // nothing, is untangled as if turned: its corners, a patch of three, move
 // as one piece, and it lies flat again; the count of turned triangles stays
 // 0. The same rotation of a triangle that is no sliver (four fifths of the
@@ -1897,11 +1897,10 @@ TEST(FapSynthesis, AModelCalibratedOnlyForItsTargetsMakesTheSameTargets) {
 // solve from its pose mirrored, on both sides. Each is the target the whole
 // search and steering make on the same model without its mirror, within two
 // quanta (0.7 and 1.9; 0.5 and 0.01 on the tissue before the layered skin
-// and the floor), and the
-// mirror image of FAP 12's within 1 % of its largest motion (2.2 and 1.7
-// quanta of 640-690); and FAP 13 listed
-// alone, or on one worker (it then waits for no twin), is made from its
-// twin all the same, bit for bit.
+// and the floor), and the mirror image of FAP 12's within 1 % of its largest
+// motion (2.2 and 1.7 quanta of 640-690); and FAP 13 listed alone, or on one
+// worker (it then waits for no twin), is made from its twin all the same,
+// bit for bit.
 TEST(FapSynthesis, ARightFapIsMadeFromItsLeftTwinAsTheWholeSearchMakesIt) {
   FapSynthesisOptions o;
   o.only = {12, 13};
