@@ -79,6 +79,17 @@ std::vector<FapMapping> make_table() {
     if (!outer) t.back().second_negative = with(middle_push, middle_pull);  // the outer lip's group
     add(6 + o, D::Muscles, 70, {{"risorius_left", 100}}, {{"orbicularis_oris", 100}}, io);
     add(7 + o, D::Muscles, 70, {{"risorius_right", 100}}, {{"orbicularis_oris", 100}}, io);
+    // The corner drawn in, where orbicularis oris alone falls short (Song:
+    // 61 % of the reference, the skin folding past its range): risorius,
+    // driven backwards, pushes the corner toward the mouth's middle, and
+    // zygomaticus major's push, less, adds to it. Song's corner then comes
+    // in the whole reference, lower by a quarter of it and forward (the
+    // lips purse); the generated heads' reach it with the sphincter alone.
+    for (int k = 0; k < 2; ++k) {
+      const std::string side = k ? "right" : "left";
+      t[t.size() - 2 + static_cast<size_t>(k)].second_negative = {
+          {"orbicularis_oris", 100}, {"risorius_" + side, -100}, {"zygomaticus_major_" + side, -30}};
+    }
     add(8 + o, D::Muscles, 120, {{"upper_lip_left", 100}}, {{"upper_lip_left", -100}}, io);
     add(9 + o, D::Muscles, 120, {{"upper_lip_right", 100}}, {{"upper_lip_right", -100}}, io);
     // The lip's side, where the upper lip muscle alone falls short: pushed

@@ -1311,7 +1311,12 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
                          (second.message.empty() ? "" : "; " + second.message);
         second.seconds += first.seconds;
       } else {
-        first.message += "; its second group (" + group + ") came no nearer";
+        // What it reached, so that a reader can judge the group.
+        char b[96] = "made no target";
+        if (second.made)
+          std::snprintf(b, sizeof b, "reached %.0f %% of the prescribed motion, %.0f %% off-axis",
+                        100 * second.reached, 100 * second.off_axis);
+        first.message += "; its second group (" + group + ") came no nearer: " + b;
         first.seconds += second.seconds;
         results[k] = std::move(own[j]);
       }
