@@ -1,5 +1,6 @@
 #include "anatomy/jaw.h"
 
+#include <Eigen/Sparse>
 #include <algorithm>
 #include <cmath>
 
@@ -107,9 +108,57 @@ Expected<Jaw> build_jaw(const SkinModel &skin, const FdpSet &fdps, const Fapu &f
         return skin.in_mesh[static_cast<size_t>(u)] && !std::binary_search(upper.begin(), upper.end(), u) &&
                skin.X0(u, 1) < line_y(skin.X0(u, 0));
       });
+  std::vector<double> fixed(static_cast<size_t>(skin.n), 0.0);  // the shares the side's field is held to
+  for (int v : jaw.vertices) fixed[static_cast<size_t>(v)] = 1;
   for (int v = 0; v < skin.n; ++v) {
     const double d = dist[static_cast<size_t>(v)];
-    if (d > 0 && d < band) jaw.followers.emplace_back(v, 0.5 * (1 + std::cos(3.14159265358979323846 * d / band)));
+    if (d > 0 && d < band) fixed[static_cast<size_t>(v)] = 0.5 * (1 + std::cos(3.14159265358979323846 * d / band));
+  }
+
+  // The skin beside the jaw (jaw.h, "Followers"): above the jaw line and
+  // beyond the mouth corners, within kJawSideBand x MW0 of the jaw's
+  // vertices along the skin. Its shares are harmonic: each one the mean of
+  // its neighbours', weighted by the inverse edge length, held to the
+  // shares around it (1 on the jaw's vertices, 0 beyond the band).
+  const double mid = (P("2.4").x() + P("2.5").x()) / 2,
+               beyond = std::abs(P("2.4").x() - P("2.5").x()) / 2 + kJawSideMargin * fapu.mw0,
+               side_band = kJawSideBand * fapu.mw0;
+  const std::vector<double> side =
+      edge_path_distances(skin.X0, skin.neighbours, jaw.vertices, side_band, [&](int u) {
+        return skin.in_mesh[static_cast<size_t>(u)] && !std::binary_search(upper.begin(), upper.end(), u) &&
+               skin.X0(u, 1) >= line_y(skin.X0(u, 0)) && std::abs(skin.X0(u, 0) - mid) > beyond;
+      });
+  std::vector<int> unknown(static_cast<size_t>(skin.n), -1);
+  int count = 0;
+  for (int v = 0; v < skin.n; ++v)
+    if (const double d = side[static_cast<size_t>(v)]; d > 0 && d < side_band) unknown[static_cast<size_t>(v)] = count++;
+  Eigen::VectorXd harmonic;
+  if (count > 0) {
+    std::vector<Eigen::Triplet<double>> entries;
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(count);
+    for (int v = 0; v < skin.n; ++v) {
+      const int i = unknown[static_cast<size_t>(v)];
+      if (i < 0) continue;
+      for (int u : skin.neighbours[static_cast<size_t>(v)]) {
+        const double w = 1.0 / std::max((skin.X0.row(u) - skin.X0.row(v)).norm(), 1e-12 * fapu.mw0);
+        entries.emplace_back(i, i, w);
+        if (const int j = unknown[static_cast<size_t>(u)]; j >= 0)
+          entries.emplace_back(i, j, -w);
+        else
+          rhs[i] += w * fixed[static_cast<size_t>(u)];
+      }
+    }
+    Eigen::SparseMatrix<double> L(count, count);
+    L.setFromTriplets(entries.begin(), entries.end());
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(L);
+    if (ldlt.info() != Eigen::Success) return Status::error("jaw: the shares beside the jaw cannot be solved");
+    harmonic = ldlt.solve(rhs);
+  }
+  for (int v = 0; v < skin.n; ++v) {
+    const int i = unknown[static_cast<size_t>(v)];
+    const double share = i >= 0 ? std::clamp(harmonic[i], 0.0, 1.0) : fixed[static_cast<size_t>(v)];
+    if (share > 0 && share < 1) jaw.followers.emplace_back(v, share);
+    if (i >= 0 && share > 0 && share < 1) ++jaw.beside;
   }
 
   jaw.pivot = Eigen::Vector3d(0, (P("5.3").y() + P("5.4").y()) / 2, (P("2.13").z() + P("2.14").z()) / 2);

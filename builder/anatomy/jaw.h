@@ -28,6 +28,18 @@
 // skin under the chin into spikes along that line (the 2,000-vertex head's
 // demo). "Below the jaw line": under the polyline of the jaw mesh's lower
 // row through the FDPs, in x and y; never the upper lip.
+// Beside the jaw too: above the jaw line, farther from the face's middle
+// than the mouth corners by kJawSideMargin x MW0, within kJawSideBand x MW0
+// of the jaw's vertices along the skin. There the share is harmonic, each
+// vertex's the mean of its neighbours' weighted by the inverse edge length,
+// held to 1 on the jaw's vertices, to the followers' below and to 0 beyond
+// the band: it falls smoothly around the jaw mesh's upper corners, where a
+// distance's cosine leaves steps. Without it the skin carried whole met
+// skin tied to the skull across one edge in front of the jaw's corners,
+// and the jaw wide open turned slabs of tissue through themselves there
+// (the generated 1,000-vertex head: 5 slabs, 4 triangles; the 10k head's
+// whole skin: 13 and 6; none now). Nearer the corners a share drew the
+// upper lip's corner down with the jaw (Song at open_jaw 1024).
 //
 // Motion: rotation about the condyles' axis, +x through the pivot
 //   pivot = (0, mean of 5.3.y and 5.4.y, mean of 2.13.z and 2.14.z),
@@ -64,10 +76,11 @@ struct Jaw {
   double max_open = 0;              // radians at 100 %
   double max_thrust = 0, max_shift = 0;  // model units at 100 %
   double open_glide = 0;            // forward translation at 100 % opening, model units
-  // Vertices below the jaw line that take a share of its motion (see
-  // "Followers" above): (vertex, share), 0 < share < 1, sorted by vertex,
-  // none of them in `vertices`.
+  // Vertices below the jaw line and beside the jaw that take a share of
+  // its motion (see "Followers" above): (vertex, share), 0 < share < 1,
+  // sorted by vertex, none of them in `vertices`.
   std::vector<std::pair<int, double>> followers;
+  int beside = 0;                   // of the followers, those beside the jaw (above its line)
   std::vector<int> dynamic;         // V_d of a full opening, sorted (a partial one starts on less: face_model.h)
   // The calibrated pose of a full opening, from the rest carried by the
   // jaw (face_model.h: a first guess for poses that open it).
@@ -85,8 +98,13 @@ Eigen::Affine3d jaw_motion(const Jaw &jaw, double open_pct, double thrust_pct, d
 // the jaw's vertices, a follower's share, else 0.
 std::vector<double> jaw_shares(const Jaw &jaw, int n);
 
-// How far the followers reach along the skin, in mouth widths (MW0).
+// How far the followers reach along the skin, in mouth widths (MW0):
+// below the jaw line, and beside the jaw.
 constexpr double kJawFollowBand = 1.0;
+constexpr double kJawSideBand = 0.5;
+// How much farther from the face's middle than the mouth corners the skin
+// beside the jaw starts, in MW0.
+constexpr double kJawSideMargin = 0.25;
 
 // The share `share` (0..1) of a jaw motion made by jaw_motion(): the same
 // axis and pivot, the angle and the translation times `share`.

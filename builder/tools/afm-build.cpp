@@ -77,9 +77,9 @@ void usage(FILE *out) {
       "  --influence MUSCLE FILE.png\n"
       "                          one muscle's influence area red and the nodes its elastic\n"
       "                          wave moves green (repeatable)\n"
-      "  --jaw-map FILE.png      skin carried by the jaw (violet; paler below it, where\n"
-      "                          the skin follows in part), the jaw mesh and its pivot,\n"
-      "                          the lips' contact pairs\n"
+      "  --jaw-map FILE.png      skin carried by the jaw (violet; paler below and beside\n"
+      "                          it, where the skin follows in part), the jaw mesh and\n"
+      "                          its pivot, the lips' contact pairs\n"
       "  --contract MUSCLE=PCT   contract a muscle, -100..100 %% of its calibrated range\n"
       "                          (repeatable; positive is the muscle's action)\n"
       "  --jaw PCT               open the jaw, 0..100 %% (100 %% is 20 degrees)\n"
@@ -439,8 +439,9 @@ int main(int argc, char **argv) {
   }
   const Jaw &j = model->jaw;
   std::printf("jaw: %zu skin vertices (%zu ray hits, %d removed and %d added by the mouth-window search), "
-              "%zu below them follow in part, V_d %zu, pivot (%.4g %.4g %.4g)\n",
-              j.vertices.size(), j.ray_hits.size(), j.removed, j.added, j.followers.size(), j.dynamic.size(), j.pivot.x(),
+              "%zu below and %d beside them follow in part, V_d %zu, pivot (%.4g %.4g %.4g)\n",
+              j.vertices.size(), j.ray_hits.size(), j.removed, j.added, j.followers.size() - static_cast<size_t>(j.beside),
+              j.beside, j.dynamic.size(), j.pivot.x(),
               j.pivot.y(), j.pivot.z());
   std::printf("built in %.2f s\n", seconds);
   const SolveCounts before = totals.counts();

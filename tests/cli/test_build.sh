@@ -174,7 +174,8 @@ cmp -s "$tmp/work1.txt" "$tmp/work2.txt" || fail "--stats: two runs at one worke
   fail "a placement run failed: $(cat "$tmp/out.txt")"
 grep -q "^skin: part 'skin', [0-9]* vertices" "$tmp/out.txt" || fail "no skin summary"
 grep -q "^orbicularis_oris " "$tmp/out.txt" || fail "no muscle table"
-grep -q "^jaw: .* skin vertices .*, [1-9][0-9]* below them follow in part" "$tmp/out.txt" || fail "no jaw summary with its followers"
+grep -q "^jaw: .* skin vertices .*, [1-9][0-9]* below and [1-9][0-9]* beside them follow in part" "$tmp/out.txt" ||
+  fail "no jaw summary with its followers"
 grep -q "^  lips: [1-9][0-9]* vertex pairs" "$tmp/out.txt" || fail "no lip contact pairs in the summary"
 for p in map zyg jaw; do
   sig=$(od -An -tx1 -N8 "$tmp/$p.png" 2>/dev/null | tr -d ' \n')
