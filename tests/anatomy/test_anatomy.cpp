@@ -1582,7 +1582,9 @@ TEST(Physics, PosesStartedFromTheCalibratedPosesAddedAreTheSameEquilibria) {
     EXPECT_LE((settled->X - alone.X).cwiseAbs().maxCoeff(), m->quantum);
   }
   // Both at 70 % and -60 %, and both at 50 % with the jaw open 40 %: the same
-  // equilibrium as from rest, in fewer iterations.
+  // equilibrium as from rest, in fewer iterations, or with the jaw no more
+  // (5 and 5; 7 and 6 until the skin beside the jaw took a share of its
+  // motion, jaw.h).
   for (double pct : {70.0, -60.0, 50.0}) {
     Activation two;
     two.muscles = {{zyg, pct}, {ris, pct}};
@@ -1593,7 +1595,11 @@ TEST(Physics, PosesStartedFromTheCalibratedPosesAddedAreTheSameEquilibria) {
     Expected<Pose> warm = solve_pose(*m, two, &cache, po);
     ASSERT_TRUE(rest.is_ok() && warm.is_ok());
     EXPECT_LE((pose_epidermis(*m, *warm) - pose_epidermis(*m, *rest)).cwiseAbs().maxCoeff(), m->quantum) << pct;
-    EXPECT_LT(warm->stats.iterations, rest->stats.iterations) << pct;
+    if (two.jaw_open > 0) {
+      EXPECT_LE(warm->stats.iterations, rest->stats.iterations) << pct;
+    } else {
+      EXPECT_LT(warm->stats.iterations, rest->stats.iterations) << pct;
+    }
     // Not the pose itself: the guess moves the corner further than the
     // muscles together do, but not twice as far.
     const int corner = m->fdps.find(*FdpId::parse("8.3"), m->skin)->vertex;
