@@ -1003,7 +1003,7 @@ TEST(FapSynthesis, TheReportCountsTheSlabsAPoseTurnsAndTheCollapseFloorLeavesNon
   };
   const std::vector<int> plain = jaw_slabs(0);
   ASSERT_EQ(plain.size(), 3u) << "FAP 3 at its reference and its in-betweens at 640 and 1024";
-  EXPECT_GT(*std::max_element(plain.begin(), plain.end()), 0) << "the count sees the folded chin";
+  EXPECT_GT(*std::max_element(plain.begin(), plain.end()), 0) << "the count sees the turned slab";
   EXPECT_EQ(jaw_slabs(0.3), std::vector<int>(3, 0));
   std::printf("FAP 3's targets without the floor turn %d, %d and %d slabs\n", plain[0], plain[1], plain[2]);
 }
@@ -2862,7 +2862,7 @@ TEST(FapSynthesis, SongsInnerLowerLipSideComesDownToItsReferenceWithoutAFold) {
 }
 
 // Song's left mouth corner drawn in (FAP 6's negative side; Crystal's
-// streams send it to -80): orbicularis oris alone took 8.4 61 % of the
+// streams send it to -80): orbicularis oris alone took 2.4 61 % of the
 // reference in and held it there, the skin folding past its range. Its
 // second group (fap_mapping.cpp) adds risorius driven backwards, a push
 // toward the mouth's middle, and zygomaticus major's, less: the corner
