@@ -102,12 +102,14 @@ Expected<Jaw> build_jaw(const SkinModel &skin, const FdpSet &fdps, const Fapu &f
     const auto &[x1, y1] = line[k];
     return x1 > x0 ? y0 + (y1 - y0) * (x - x0) / (x1 - x0) : std::min(y0, y1);
   };
+  // Skin a follower may be: on the mesh, not the upper lip.
+  auto may_follow = [&](int u) {
+    return skin.in_mesh[static_cast<size_t>(u)] && !std::binary_search(upper.begin(), upper.end(), u);
+  };
   const double band = kJawFollowBand * fapu.mw0;
-  const std::vector<double> dist =
-      edge_path_distances(skin.X0, skin.neighbours, jaw.vertices, band, [&](int u) {
-        return skin.in_mesh[static_cast<size_t>(u)] && !std::binary_search(upper.begin(), upper.end(), u) &&
-               skin.X0(u, 1) < line_y(skin.X0(u, 0));
-      });
+  const std::vector<double> dist = edge_path_distances(skin.X0, skin.neighbours, jaw.vertices, band, [&](int u) {
+    return may_follow(u) && skin.X0(u, 1) < line_y(skin.X0(u, 0));
+  });
   std::vector<double> fixed(static_cast<size_t>(skin.n), 0.0);  // the shares the side's field is held to
   for (int v : jaw.vertices) fixed[static_cast<size_t>(v)] = 1;
   for (int v = 0; v < skin.n; ++v) {
@@ -125,13 +127,13 @@ Expected<Jaw> build_jaw(const SkinModel &skin, const FdpSet &fdps, const Fapu &f
                side_band = kJawSideBand * fapu.mw0;
   const std::vector<double> side =
       edge_path_distances(skin.X0, skin.neighbours, jaw.vertices, side_band, [&](int u) {
-        return skin.in_mesh[static_cast<size_t>(u)] && !std::binary_search(upper.begin(), upper.end(), u) &&
-               skin.X0(u, 1) >= line_y(skin.X0(u, 0)) && std::abs(skin.X0(u, 0) - mid) > beyond;
+        return may_follow(u) && skin.X0(u, 1) >= line_y(skin.X0(u, 0)) && std::abs(skin.X0(u, 0) - mid) > beyond;
       });
   std::vector<int> unknown(static_cast<size_t>(skin.n), -1);
   int count = 0;
   for (int v = 0; v < skin.n; ++v)
-    if (const double d = side[static_cast<size_t>(v)]; d > 0 && d < side_band) unknown[static_cast<size_t>(v)] = count++;
+    if (const double d = side[static_cast<size_t>(v)]; d > 0 && d < side_band)
+      unknown[static_cast<size_t>(v)] = count++;
   Eigen::VectorXd harmonic;
   if (count > 0) {
     std::vector<Eigen::Triplet<double>> entries;
@@ -157,8 +159,9 @@ Expected<Jaw> build_jaw(const SkinModel &skin, const FdpSet &fdps, const Fapu &f
   for (int v = 0; v < skin.n; ++v) {
     const int i = unknown[static_cast<size_t>(v)];
     const double share = i >= 0 ? std::clamp(harmonic[i], 0.0, 1.0) : fixed[static_cast<size_t>(v)];
-    if (share > 0 && share < 1) jaw.followers.emplace_back(v, share);
-    if (i >= 0 && share > 0 && share < 1) ++jaw.beside;
+    if (share <= 0 || share >= 1) continue;
+    jaw.followers.emplace_back(v, share);
+    if (i >= 0) ++jaw.beside;
   }
 
   jaw.pivot = Eigen::Vector3d(0, (P("5.3").y() + P("5.4").y()) / 2, (P("2.13").z() + P("2.14").z()) / 2);
