@@ -23,7 +23,10 @@
 // sparse Cholesky factorization package", 2005) with blocks for scalars:
 // row k of L solves a sparse triangular system whose pattern is the reach
 // of column k's upper part in the elimination tree; then
-// L(k, i) = (D_i^-1 Y_i)^T and D_k = K_kk - sum_i L(k, i) Y_i.
+// L(k, i) = (D_i^-1 Y_i)^T and D_k = K_kk - sum_i L(k, i) Y_i. D_k^-1 comes
+// from D_k's Cholesky factor where D_k is positive definite; where it is
+// not, D_k's LDL^T (with pivoting) tells indefinite from singular and an LU
+// decomposition inverts it.
 //
 // Usage (solver.cpp): analyze() once per pattern, factorize() per matrix of
 // that pattern, solve() or precondition() as often as needed. Not
