@@ -96,7 +96,7 @@ void column_update(double *y, const int *rows, const double *L, int count, const
 // into `inv` when A is positive definite: A = C C^T (Cholesky), W = C^-1,
 // A^-1 = W^T W, in plain loops. Eigen's LDLT (for D's signs) and its LU
 // inverse did the same for every pivot through their general machinery:
-// 3.7 % of the instructions of Song's AFM, these loops about 0.9 %. False
+// 3.7 % of the instructions of Song's AFM, these loops about 0.8 %. False
 // when a pivot of C is not positive (A not definite, or singular): the
 // caller then classifies A by its LDLT and inverts it by LU.
 template <int B>
