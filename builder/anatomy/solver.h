@@ -75,7 +75,11 @@
 //                   with a fresh one. The fill-reducing
 //                   ordering is computed once per dynamic set (FactorCache),
 //                   and a solve on a set starts with the factorisation the
-//                   last solve there ended on.
+//                   last solve there ended on. After a step that moved no
+//                   node more than 10 tol, and less than a quarter of the
+//                   step before, the next one is made on the last full
+//                   tangent (a chord step), assembling the force alone
+//                   (SolverOptions::keep_tangent).
 //                   The tangent: the Hessian where it is definite; where
 //                   not, the one with half its indefinite parts (compressed
 //                   springs' negative transverse stiffness, the volume's
@@ -199,6 +203,11 @@ struct SolverOptions {
   // its indefinite parts first, kept where it is definite, before the
   // projected one (see "newton" above). Off: the projected one directly.
   bool half_tangent = true;
+  // newton solvers: after a step that moved no node more than 10 tol and
+  // less than a quarter of the step before (converging fast), the next one
+  // is made on the last full tangent, and only the force is assembled (see
+  // "newton" above). Off: a tangent every step.
+  bool keep_tangent = true;
   // Hold the lips apart (SkinModel::lip_pairs, lip_contact.h; "lips" above).
   // Off for the FAP targets and the muscles' calibration: MPEG-4 moves each
   // lip by its own FAPs, and a FAP that presses one lip onto the other moves
@@ -216,6 +225,7 @@ struct SolveStats {
   int cg_iterations = 0;  // summed over every linear solve
   int factorisations = 0; // numeric factorisations of the tangent (newton)
   int half_steps = 0;     // Newton steps made on the half tangent (SolverOptions::half_tangent)
+  int chord_steps = 0;    // Newton steps made on the last step's tangent (SolverOptions::keep_tangent)
   int assemblies = 0;     // tangents assembled (each with the force at the same positions, or alone)
   int energies = 0;       // total energies evaluated (the newton solvers' line search)
   int unknowns = 0;       // 3 x free nodes
