@@ -225,7 +225,7 @@ struct SolveStats {
   int cg_iterations = 0;  // summed over every linear solve
   int factorisations = 0; // numeric factorisations of the tangent (newton)
   int half_steps = 0;     // Newton steps made on the half tangent (SolverOptions::half_tangent)
-  int chord_steps = 0;    // Newton steps made on the last step's tangent (SolverOptions::keep_tangent)
+  int chord_steps = 0;    // Newton steps made on a kept full tangent, none assembled (SolverOptions::keep_tangent)
   int assemblies = 0;     // tangents assembled (each with the force at the same positions, or alone)
   int energies = 0;       // total energies evaluated (the newton solvers' line search)
   int unknowns = 0;       // 3 x free nodes
