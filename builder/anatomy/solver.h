@@ -208,6 +208,9 @@ struct SolverOptions {
   // is made on the last full tangent, and only the force is assembled (see
   // "newton" above). Off: a tangent every step.
   bool keep_tangent = true;
+  // newton solvers, for tests: after each carried energy (SolveStats::
+  // carried_energies), evaluate the whole one too and record the gap.
+  bool check_carried_energy = false;
   // Hold the lips apart (SkinModel::lip_pairs, lip_contact.h; "lips" above).
   // Off for the FAP targets and the muscles' calibration: MPEG-4 moves each
   // lip by its own FAPs, and a FAP that presses one lip onto the other moves
@@ -228,6 +231,13 @@ struct SolveStats {
   int chord_steps = 0;    // Newton steps made on a kept full tangent, none assembled (SolverOptions::keep_tangent)
   int assemblies = 0;     // tangents assembled (each with the force at the same positions, or alone)
   int energies = 0;       // total energies evaluated (the newton solvers' line search)
+  // Newton steps after which the contacts moved nodes and the line search's
+  // tissue energy was carried over, with the change of the terms the moved
+  // nodes are in, instead of evaluated again; and, with
+  // SolverOptions::check_carried_energy, the largest gap between the carried
+  // energy and the one evaluated there, relative to the latter.
+  int carried_energies = 0;
+  double carried_energy_gap = 0;
   int unknowns = 0;       // 3 x free nodes
   int contacts = 0;       // nodes held on the skull at the end
   double residual = 0;    // the Jacobi displacement estimate at the end, model units
@@ -236,8 +246,9 @@ struct SolveStats {
   std::string message;    // why it failed; empty when converged
 };
 
-// Adds `more`'s work (the counts from iterations to energies, and the
-// seconds) to `into`'s; the rest of `into` stays.
+// Adds `more`'s work (the counts from iterations to carried_energies, and
+// the seconds) to `into`'s, and keeps the larger carried_energy_gap; the
+// rest of `into` stays.
 void add_work(SolveStats &into, const SolveStats &more);
 
 // The Hessian of a load's potential, as 3 x 3 blocks on single nodes
