@@ -130,7 +130,6 @@ class BlockLdlt {
   mutable std::vector<double> solve_work_;
   // precondition()'s factors: b columns of float_rows(b) floats per block
   // (block_ldlt.cpp; the rows past b zero).
-  std::vector<float> lf_;   // per L block (by columns, as l_): its transpose
   std::vector<float> df_;   // per group: d_inverse_
   std::vector<int> row_start_;  // L's blocks by rows: row k's are row_start_[k] .. row_start_[k + 1] - 1
   std::vector<int> rcol_;       // per block by rows: its block column

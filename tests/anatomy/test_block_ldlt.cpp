@@ -115,7 +115,7 @@ TEST(BlockLdlt, SolvesAPositiveDefiniteSystemAsADenseCholeskyDoes) {
   Eigen::VectorXd x2;
   f.solve(b, x2);
   EXPECT_LT((2 * x2 - ref).norm(), 1e-10 * ref.norm());
-  // The preconditioner's copies (by rows and by columns) are renewed too.
+  // The preconditioner's float copy is renewed too.
   f.precondition(b, xf);
   EXPECT_LT((2 * xf - ref).norm(), 1e-5 * ref.norm());
 }
