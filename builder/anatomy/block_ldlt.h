@@ -84,14 +84,14 @@ class BlockLdlt {
   void solve(const Eigen::VectorXd &b, Eigen::VectorXd &x) const;
 
   // x ~ K^-1 b in single precision, for preconditioning (only when
-  // complete()): float copies of
-  // the factors, made by factorize(), L by rows for the forward pass and by
-  // columns for the backward one, so that both sum in registers (gathers);
-  // 3 x 3 blocks padded to 4 x 3, a block times a vector being three 4-wide
+  // complete()): a float copy of the factors, made by factorize(), L by
+  // rows, read by both passes (the forward one sums a row in registers, the
+  // backward one goes up the rows subtracting each block transposed); 3 x 3
+  // blocks padded to 4 x 3, a block times a vector being three 4-wide
   // multiply-adds (9 x 9 blocks are not padded). Half the memory read by
-  // solve(); with 3 x 3 blocks their share of the CPU of Song's AFM fell
-  // from 19.8 to 16.8 % against unpadded blocks scattered by columns (perf,
-  // one worker).
+  // solve(). One copy, not a second by columns for the backward pass: the
+  // passes read as many bytes either way, but from half the memory, and
+  // took 1.55 times as long with two (block_ldlt.cpp).
   void precondition(const Eigen::VectorXd &b, Eigen::VectorXd &x) const;
 
   // The cost model of the solver's refresh rule, in scalar terms: the
