@@ -91,7 +91,7 @@ class BlockLdlt {
   // three 4-wide multiply-adds (9 x 9 blocks are not padded). Half the
   // memory read by solve(). One copy, not a second by columns for the
   // backward pass: the same bits, the same bytes read, but from half the
-  // memory, and 1.2 to 1.3 times faster (block_ldlt.cpp).
+  // memory, and faster (block_ldlt.cpp has the figures).
   void precondition(const Eigen::VectorXd &b, Eigen::VectorXd &x) const;
 
   // The cost model of the solver's refresh rule, in scalar terms: the
