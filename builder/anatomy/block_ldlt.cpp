@@ -33,6 +33,17 @@ inline void subtract_product(float *acc, const float *M, const float *z) {
   }
 }
 
+// y -= M^T x: M is b columns of P floats, x has at least b; entry c of
+// M^T x is column c of M dotted with x.
+template <int B, int P>
+inline void subtract_transposed_product(float *y, const float *M, const float *x) {
+  for (int c = 0; c < B; ++c) {
+    float s = 0;
+    for (int r = 0; r < B; ++r) s += M[c * P + r] * x[r];
+    y[c] -= s;
+  }
+}
+
 // out = M z: M is b columns of P floats, z has at least b.
 template <int B, int P>
 inline void product(float *out, const float *M, const float *z) {
@@ -237,7 +248,6 @@ bool BlockLdlt::analyze(const SpMat &pattern, int group, bool upper_only) {
   filled_.assign(static_cast<size_t>(groups), 0);
   lrf_.assign(blocks * fb, 0.f);
   rcol_.assign(blocks, 0);
-  col_slot_.assign(blocks, 0);
   df_.assign(static_cast<size_t>(groups) * fb, 0.f);
   return true;
 }
@@ -300,7 +310,6 @@ BlockLdlt::Result BlockLdlt::factorize_blocks(const SpMat &K, bool stop_if_indef
       const size_t slot = static_cast<size_t>(row_start_[static_cast<size_t>(k)] + (p - top));
       to_float<B, P>(lki.data(), &lrf_[slot * B * P]);
       rcol_[slot] = static_cast<int>(i);
-      col_slot_[static_cast<size_t>(end)] = static_cast<int>(slot);
       ++filled_[i];
     }
     MapB<B> dinv(&d_inverse_[static_cast<size_t>(k) * BB]);
@@ -358,19 +367,20 @@ void BlockLdlt::precondition(const Eigen::VectorXd &b, Eigen::VectorXd &x) const
 namespace {
 
 // The passes of precondition() on z (n blocks of P floats, b's entries
-// gathered into it in the analysed order), both reading the one float copy
-// of L, stored by rows: forward by rows, so that row k's sum stays in
-// registers (a pass by columns would read and write z once per block); D^-1;
-// backward by columns, column i's blocks found through col_slot, each
-// transposed into T first, so that it is summed as the forward pass sums
-// (and as the second copy by columns did before the seventy-first session,
-// bit for bit). With that second copy the passes read as many bytes, but
-// from twice the memory (3.6 MB a copy on a tangent of Song's, 10,557
-// unknowns; this machine has 8 MB of cache for both cores), and a
-// precondition there took 840-970 us against 710-780 us with one copy.
+// gathered into it in the analysed order), both over the one float copy of
+// L, stored by rows: forward, row k's sum kept in registers (a pass by
+// columns would read and write z once per block); D^-1; backward going up
+// the rows, row k's final x_k subtracted from each z_j as L(k, j)^T x_k
+// (column c of L(k, j) dotted with x_k). Reading L by rows backwards streams
+// it: on a tangent of Song's (10,557 unknowns, 3.6 MB of float L) a
+// precondition took 552 us against 857 us by columns, each block found
+// through an index and transposed (the seventy-first session); an AVX2
+// transpose in registers was no faster by columns, so the order is what
+// counts. The backward sums differ from a pass by columns in their
+// rounding only.
 template <int B, int P>
 inline void precondition_passes(size_t n, const int *row_start, const int *rcol, const float *lrf, const float *df,
-                                const int *col_start, const int *row, const int *col_slot, float *z) {
+                                float *z) {
   constexpr size_t FB = B * P;
   for (size_t k = 0; k < n; ++k) {
     float acc[P];
@@ -384,24 +394,17 @@ inline void precondition_passes(size_t n, const int *row_start, const int *rcol,
     std::copy(z + i * P, z + i * P + P, zi);
     product<B, P>(z + i * P, df + i * FB, zi);
   }
-  for (size_t i = n; i-- > 0;) {
-    float acc[P];
-    std::copy(z + i * P, z + i * P + P, acc);
-    for (int q = col_start[i]; q < col_start[i + 1]; ++q) {
-      const float *M = lrf + static_cast<size_t>(col_slot[q]) * FB;
-      float T[FB];
-      for (int c = 0; c < B; ++c)
-        for (int r = 0; r < P; ++r) T[c * P + r] = r < B ? M[r * P + c] : 0.f;
-      subtract_product<B, P>(acc, T, z + static_cast<size_t>(row[q]) * P);
-    }
-    std::copy(acc, acc + P, z + i * P);
+  for (size_t k = n; k-- > 0;) {
+    float xk[P];
+    std::copy(z + k * P, z + k * P + P, xk);
+    for (int e = row_start[k]; e < row_start[k + 1]; ++e)
+      subtract_transposed_product<B, P>(z + static_cast<size_t>(rcol[e]) * P, lrf + static_cast<size_t>(e) * FB, xk);
   }
 }
 
 AFM_KERNEL_CLONES void precondition_passes9(size_t n, const int *row_start, const int *rcol, const float *lrf,
-                                            const float *df, const int *col_start, const int *row,
-                                            const int *col_slot, float *z) {
-  precondition_passes<9, float_rows(9)>(n, row_start, rcol, lrf, df, col_start, row, col_slot, z);
+                                            const float *df, float *z) {
+  precondition_passes<9, float_rows(9)>(n, row_start, rcol, lrf, df, z);
 }
 
 }  // namespace
@@ -416,11 +419,9 @@ void BlockLdlt::precondition_blocks(const Eigen::VectorXd &b, Eigen::VectorXd &x
   for (size_t k = 0; k < n; ++k)
     for (int r = 0; r < P; ++r) z[k * P + r] = r < B ? static_cast<float>(b[static_cast<Eigen::Index>(B) * order_[k] + r]) : 0.f;
   if constexpr (B == 9)
-    precondition_passes9(n, row_start_.data(), rcol_.data(), lrf_.data(), df_.data(), col_start_.data(), row_.data(),
-                         col_slot_.data(), z.data());
+    precondition_passes9(n, row_start_.data(), rcol_.data(), lrf_.data(), df_.data(), z.data());
   else
-    precondition_passes<B, P>(n, row_start_.data(), rcol_.data(), lrf_.data(), df_.data(), col_start_.data(),
-                              row_.data(), col_slot_.data(), z.data());
+    precondition_passes<B, P>(n, row_start_.data(), rcol_.data(), lrf_.data(), df_.data(), z.data());
   x.resize(b.size());
   for (size_t i = 0; i < n; ++i)
     for (int r = 0; r < B; ++r) x[static_cast<Eigen::Index>(B) * order_[i] + r] = z[i * P + r];

@@ -134,7 +134,6 @@ class BlockLdlt {
   std::vector<int> row_start_;  // L's blocks by rows: row k's are row_start_[k] .. row_start_[k + 1] - 1
   std::vector<int> rcol_;       // per block by rows: its block column
   std::vector<float> lrf_;      // per block by rows: L(k, rcol_)
-  std::vector<int> col_slot_;   // per L block by columns (as l_): its place in lrf_
   mutable std::vector<float> solve_work_f_;
   double factor_flops_ = 0, nonzeros_ = 0;
 };

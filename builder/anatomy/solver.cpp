@@ -1083,10 +1083,11 @@ SolveStats solve_equilibrium(const SkinModel &model, const std::vector<int> &ver
   // short a step, and a step on it (a chord step) converges about as fast.
   // Song's AFM: 9 % fewer tangents, as many Newton iterations, 3.1 % fewer
   // instructions (callgrind, one worker); the generated heads 11-14 % fewer
-  // tangents. Without the quarter, a buckled stiff skin went on to another
-  // of its flat equilibria (Solver.TheHalfTangentCutsTheCrawlOnAStiffSkin:
-  // 47 iterations instead of 35, 29 quanta away); at 20 tolerances Song's
-  // AFM took 3 % more iterations.
+  // tangents. Without the quarter, a buckled stiff skin's solve crawled
+  // along its flat equilibrium (Solver.TheHalfTangentCutsTheCrawlOnAStiffSkin:
+  // 47 iterations instead of 35; with the seventy-second session's
+  // preconditioner, no progress in 60); at 20 tolerances Song's AFM took
+  // 3 % more iterations.
   constexpr double kKeepTangent = 10, kConverging = 0.25;
   const Ldlt *rest = nullptr;
   if (options.kind == SolverKind::NewtonRest) {

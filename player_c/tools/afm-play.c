@@ -56,7 +56,11 @@ static void usage(FILE *out) {
           "--folds: in every frame, the skin's triangles (parts of kind skin) whose\n"
           "normal points against their rest normal, the head's rotation left out;\n"
           "slivers under a thousandth of the skin's mean rest area are not counted, as\n"
-          "in afm-build's report. Each frame line gets 'turned N' before its hash, and\n"
+          "in afm-build's report. A triangle counts only when it stays turned with its\n"
+          "corners moved by up to a position quantum (the normal's component along\n"
+          "the rest normal below minus a quantum times its perimeter, the first-order\n"
+          "bound of that move): within a quantum of edge-on, the stored positions do\n"
+          "not tell which way it faces. Each frame line gets 'turned N' before its hash, and\n"
           "the summary says how many frames turn any, and the most one frame turns,\n"
           "with that frame's nonzero FAP values.\n"
           "\n"
@@ -317,30 +321,38 @@ static int compare_double(const void *a, const void *b) {
 /* --folds (see usage): the skin triangles counted and their rest normals. */
 typedef struct folds {
   uint32_t *triangle;      /* indices into geometry.triangles */
-  double *normal;          /* [3 x count] rest normals, position quanta squared */
+  double *normal;          /* [3 x count] rest normals, unit length */
   uint32_t count;          /* skin triangles counted (slivers left out) */
   uint32_t frames;         /* frames turning any */
   uint32_t most, most_frame; /* the most one frame turns, and that frame */
   afm_fap_state most_state; /* the values there */
 } folds;
 
-static void triangle_normal(const afm_geometry *g, const int32_t *x, uint32_t tri, double n[3]) {
-  double p[3][3], u[3], v[3];
+/* Triangle tri's normal (twice its area) at positions x (the rest positions
+ * when x is null), in quanta; returns its perimeter, in quanta. */
+static double triangle_normal(const afm_geometry *g, const int32_t *x, uint32_t tri, double n[3]) {
+  double p[3][3], u[3], v[3], perimeter = 0;
   int c, k;
   for (c = 0; c < 3; ++c) {
     const uint32_t i = g->triangles[3 * tri + (uint32_t)c];
     for (k = 0; k < 3; ++k)
       p[c][k] = x ? (double)x[3 * i + (uint32_t)k] : (double)(k == 0 ? g->px[i] : k == 1 ? g->py[i] : g->pz[i]);
   }
+  for (c = 0; c < 3; ++c) {
+    double e = 0;
+    for (k = 0; k < 3; ++k) e += (p[(c + 1) % 3][k] - p[c][k]) * (p[(c + 1) % 3][k] - p[c][k]);
+    perimeter += sqrt(e);
+  }
   for (k = 0; k < 3; ++k) u[k] = p[1][k] - p[0][k], v[k] = p[2][k] - p[0][k];
   n[0] = u[1] * v[2] - u[2] * v[1];
   n[1] = u[2] * v[0] - u[0] * v[2];
   n[2] = u[0] * v[1] - u[1] * v[0];
+  return perimeter;
 }
 
-/* The skin's triangles with their rest normals (in quanta: only the sign of
- * a dot product is used), slivers under a thousandth of the mean left out:
- * every skin triangle first, then the slivers dropped in place. */
+/* The skin's triangles with their unit rest normals, slivers under a
+ * thousandth of the mean left out: every skin triangle first, then the
+ * slivers dropped in place. */
 static int folds_init(folds *fo, const afm_doc *doc) {
   const afm_geometry *g = &doc->geometry;
   uint32_t part, tri, i, total = 0;
@@ -363,9 +375,11 @@ static int folds_init(folds *fo, const afm_doc *doc) {
   }
   for (i = 0, fo->count = 0; i < total; ++i) {
     const double *n = fo->normal + 3 * i;
-    if (!(sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) > 1e-3 * sum / total)) continue;
+    const double length = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    double *unit = fo->normal + 3 * fo->count;
+    if (!(length > 1e-3 * sum / total)) continue;
     fo->triangle[fo->count] = fo->triangle[i];
-    memmove(fo->normal + 3 * fo->count, n, 3 * sizeof *n);
+    unit[0] = n[0] / length, unit[1] = n[1] / length, unit[2] = n[2] / length;
     ++fo->count;
   }
   return 1;
@@ -385,8 +399,10 @@ static uint32_t folds_add(folds *fo, const afm_doc *doc, const afm_player *p, ui
   double n[3];
   for (i = 0; i < fo->count; ++i) {
     const double *n0 = fo->normal + 3 * i;
-    triangle_normal(&doc->geometry, x, fo->triangle[i], n);
-    turned += n0[0] * n[0] + n0[1] * n[1] + n0[2] * n[2] <= 0;
+    /* Moving corner c by d changes n by d x (its opposite edge): by at most
+     * a quantum times the perimeter for moves up to a quantum (first order). */
+    const double perimeter = triangle_normal(&doc->geometry, x, fo->triangle[i], n);
+    turned += n0[0] * n[0] + n0[1] * n[1] + n0[2] * n[2] < -perimeter;
   }
   if (turned) ++fo->frames;
   if (turned > fo->most) {

@@ -115,13 +115,16 @@ hashes=$(awk '$1 == "frame" { print $NF }' "$tmp/play.txt" | sort -u | wc -l)
 
 # afm-play --folds counts the skin triangles a played frame turns over. Its
 # count must agree with one made here from the frames' OBJ files (the rest
-# frame against each: the skin part's triangles whose normal turns, slivers
-# under a thousandth of the mean rest area left out). Frame 1 sends joy.fap's
+# frame against each: the skin part's triangles whose normal turns by more
+# than moving their corners by a quantum could turn it, slivers under a
+# thousandth of the mean rest area left out). Frame 1 sends joy.fap's
 # frame 75 (the corners raised, the lower lip lowered; the head still),
 # frame 2 the same three times over, which a face extrapolated that far
 # folds: the check has something to see.
 skin=$("$bin/afm-info" "$tmp/song.afm" | awk '/^  part  / { t = 1; next } t && $2 == "skin" { print $1; exit }')
 [ -n "$skin" ] || fail "Song: afm-info names no skin part"
+quantum=$("$bin/afm-info" "$tmp/song.afm" | sed -n 's/^quantisation: positions [a-z0-9]*, step \([0-9.e+-]*\) units.*/\1/p')
+[ -n "$quantum" ] || fail "Song: afm-info names no position quantum"
 {
   echo "2.1 folds 25 3"
   mask=$(awk 'BEGIN { for (f = 1; f <= 68; ++f) printf "%s%d", (f > 1 ? " " : ""), (f >= 3 && f <= 60 && (f < 23 || f > 30) && (f < 48 || f > 50)) }')
@@ -140,11 +143,13 @@ mkdir -p "$tmp/folds"
   fail "afm-play --folds failed on Song: $(tail -n 3 "$tmp/folds.txt")"
 for k in 1 2; do
   played=$(awk -v k="$k" '$1 == "frame" && $2 == k { for (i = 3; i < NF; ++i) if ($i == "turned") print $(i + 1) }' "$tmp/folds.txt")
-  counted=$(awk -v skin="$skin" 'function normal(fl, i,   a, b, c, ux, uy, uz, vx, vy, vz) {
+  counted=$(awk -v skin="$skin" -v quantum="$quantum" 'function normal(fl, i,   a, b, c, ux, uy, uz, vx, vy, vz, wx, wy, wz) {
       a = t[i, 1]; b = t[i, 2]; c = t[i, 3]
       ux = x[fl, b] - x[fl, a]; uy = y[fl, b] - y[fl, a]; uz = z[fl, b] - z[fl, a]
       vx = x[fl, c] - x[fl, a]; vy = y[fl, c] - y[fl, a]; vz = z[fl, c] - z[fl, a]
+      wx = vx - ux; wy = vy - uy; wz = vz - uz
       nx = uy * vz - uz * vy; ny = uz * vx - ux * vz; nz = ux * vy - uy * vx
+      perimeter = sqrt(ux * ux + uy * uy + uz * uz) + sqrt(vx * vx + vy * vy + vz * vz) + sqrt(wx * wx + wy * wy + wz * wz)
     }
     FNR == 1 { ++file; part = ""; nv = 0 }
     $1 == "v" { ++nv; x[file, nv] = $2; y[file, nv] = $3; z[file, nv] = $4; next }
@@ -155,7 +160,7 @@ for k in 1 2; do
       for (i = 1; i <= nf; ++i) {
         if (!(len[i] > 1e-3 * sum / nf)) continue
         normal(2, i)
-        if (rx[i] * nx + ry[i] * ny + rz[i] * nz <= 0) ++turned
+        if ((rx[i] * nx + ry[i] * ny + rz[i] * nz) / len[i] < -quantum * perimeter) ++turned
       }
       print turned + 0
     }' "$tmp/folds/frame_00000.obj" "$tmp/folds/frame_0000$k.obj")
