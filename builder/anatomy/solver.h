@@ -119,7 +119,9 @@
 //
 // Stopping rule, the same for all three, with tol = SolverOptions::tolerance
 // (afm-build passes half the AFM position quantum, so the result is exact to
-// the stored grid):
+// the stored grid, except along a soft mode, where the equilibrium is flat:
+// the Jacobi estimate misses it, and Song's lids at their calibrated range
+// stop 118-158 quanta short; docs/anatomy.md, "Stopping in flat directions"):
 //   the last update moved no node more than tol, and the Jacobi estimate of
 //   the remaining displacement, max over unknowns |r_i| / K_ii (residual
 //   force over the diagonal stiffness), is below tol.
