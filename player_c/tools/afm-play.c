@@ -60,9 +60,9 @@ static void usage(FILE *out) {
           "corners moved by up to a position quantum (the normal's component along\n"
           "the rest normal below minus a quantum times its perimeter, the first-order\n"
           "bound of that move): within a quantum of edge-on, the stored positions do\n"
-          "not tell which way it faces. Each frame line gets 'turned N' before its hash, and\n"
-          "the summary says how many frames turn any, and the most one frame turns,\n"
-          "with that frame's nonzero FAP values.\n"
+          "not tell which way it faces. Each frame line gets 'turned N' before its\n"
+          "hash, and the summary says how many frames turn any, and the most one frame\n"
+          "turns, with that frame's nonzero FAP values.\n"
           "\n"
           "Exit status: 0 on success, 1 on bad input (the message names the file and\n"
           "line or field), 2 on bad usage.\n");

@@ -2091,7 +2091,7 @@ TEST(Solver, TheHalfTangentCutsTheCrawlOnAStiffSkin) {
   // solves stop about 57 quanta short of the equilibrium, 1.3 to 2.2 quanta
   // apart as rounding (the preconditioner's) changes. Without keep_tangent's
   // bound on the step before, the solve without the half tangent took 47
-  // iterations (then stopped 29 quanta from the other); with the
+  // iterations and stopped 29 quanta from where the other did; with the
   // seventy-second session's preconditioner it no longer converges. On the
   // tissue before the layered skin and the floor (unlayered_tissue), where
   // this was measured: on the default one the half tangent takes 29
