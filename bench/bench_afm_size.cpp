@@ -55,6 +55,7 @@
 #include "afm/afm_export.h"
 #include "anatomy/face_model.h"
 #include "anatomy/sim_mesh.h"
+#include "core/allocator.h"
 #include "fap/fap_synthesis.h"
 #include "io/load_face.h"
 #include "refhead/refhead.h"
@@ -451,6 +452,7 @@ void measure(const Input &in) {
 }  // namespace
 
 int main(int argc, char **argv) {
+  keep_freed_memory();  // as afm-build does
   int threads = 0;
   std::vector<int> sizes;
   std::vector<std::string> files;

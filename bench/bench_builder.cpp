@@ -21,6 +21,7 @@
 #include "afm/afm_export.h"
 #include "anatomy/face_model.h"
 #include "anatomy/sim_mesh.h"
+#include "core/allocator.h"
 #include "fap/fap_synthesis.h"
 #include "io/load_face.h"
 #include "refhead/refhead.h"
@@ -411,6 +412,7 @@ bool run(const char *label, const Scene &scene, const FdpSet &fdps) {
 }  // namespace
 
 int main(int argc, char **argv) {
+  keep_freed_memory();  // as afm-build does
   const int n = argc > 1 ? std::atoi(argv[1]) : 10000;
   RefHeadOptions o;
   o.skin_vertices = n;

@@ -12,6 +12,7 @@
 #include "anatomy/face_model.h"
 #include "anatomy/muscle_table.h"
 #include "anatomy/sim_mesh.h"
+#include "core/allocator.h"
 #include "core/atomic_file.h"
 #include "fap/fap_mapping.h"
 #include "fap/fap_synthesis.h"
@@ -187,6 +188,7 @@ int usage_error(const std::string &msg) {
 }  // namespace
 
 int main(int argc, char **argv) {
+  keep_freed_memory();
   std::string mesh_path, fdp_path, muscle_map, jaw_map, pose_png;
   std::vector<std::pair<std::string, std::string>> influences;
   std::vector<std::pair<std::string, double>> contractions;
