@@ -8,7 +8,7 @@ namespace afmb {
 // it does nothing). Every solve builds a system and a factor cache whose
 // buffers run to a few MB (Song's AFM builds about 200); by default glibc
 // returns such blocks to the kernel when freed, and the next solve's take
-// page faults and freshly zeroed pages again: Song's AFM took 60,000-83,000
+// page faults and freshly zeroed pages again: Song's AFM took 60,000-87,000
 // minor page faults, 34,000 (its peak memory, touched once) with this. The
 // cost: the process keeps up to its peak memory until it exits. For a
 // program's main, before any allocation worth keeping; not thread-safe.
