@@ -85,13 +85,13 @@ class BlockLdlt {
 
   // x ~ K^-1 b in single precision, for preconditioning (only when
   // complete()): a float copy of the factors, made by factorize(), L by
-  // rows; the forward pass reads it by rows, the backward one by columns,
-  // each block transposed as it is read, so that both sum in registers
-  // (gathers); 3 x 3 blocks padded to 4 x 3, a block times a vector being
-  // three 4-wide multiply-adds (9 x 9 blocks are not padded). Half the
-  // memory read by solve(). One copy, not a second by columns for the
-  // backward pass: the same bits, the same bytes read, but from half the
-  // memory, and faster (block_ldlt.cpp has the figures).
+  // rows, read in order by both passes: the forward one goes down the rows
+  // summing each in registers, the backward one up the rows, subtracting
+  // each block transposed (dot products); 3 x 3 blocks padded to 4 x 3, a
+  // block times a vector being three 4-wide multiply-adds (9 x 9 blocks are
+  // not padded). Half the memory read by solve(). The passes wait on
+  // memory, so one copy read in order beats a second by columns or one read
+  // by columns (block_ldlt.cpp has the figures).
   void precondition(const Eigen::VectorXd &b, Eigen::VectorXd &x) const;
 
   // The cost model of the solver's refresh rule, in scalar terms: the
