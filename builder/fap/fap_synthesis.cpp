@@ -729,7 +729,11 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
   };
   std::vector<int> twin_of(work.size(), -1);  // the left twin's work index (a first solve, see same_as)
   std::vector<char> has_twin(work.size(), 0);
-  std::vector<std::optional<Recipe>> recipes(work.size());
+  // The recipes of the own groups' solves and of the second groups'
+  // (work[k].second): a right twin's second group starts from its left
+  // twin's second recipe where the left one was made again too.
+  std::vector<std::optional<Recipe>> recipes(work.size()), second_recipes(work.size());
+  std::vector<char> retried(work.size(), 0);  // made again with its second group
   auto miss_of = [&skin](const Pose &p, int vertex, const Eigen::Vector3d &along, double value, bool capped) {
     const int node = skin.node(kEpidermis, vertex);
     const Eigen::Vector3d m = (p.X.row(node) - skin.X0.row(node)).transpose();
@@ -999,9 +1003,10 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         // A right FAP whose left twin left a recipe: that mirrored first
         // (from_twin). Else, or where that pose is worse than the twin's, the
         // target is made as any other.
-        if (twin_of[k] >= 0 && recipes[static_cast<size_t>(twin_of[k])])
-          ok = from_twin(*recipes[static_cast<size_t>(twin_of[k])], pattern, action, value, unit, along, fdp->vertex,
-                         &cache, pose, o);
+        const size_t tw = static_cast<size_t>(std::max(twin_of[k], 0));
+        const std::optional<Recipe> &twin_recipe = work[k].second && retried[tw] ? second_recipes[tw] : recipes[tw];
+        if (twin_of[k] >= 0 && twin_recipe)
+          ok = from_twin(*twin_recipe, pattern, action, value, unit, along, fdp->vertex, &cache, pose, o);
         if (!ok) {
           double scale = 0;
           bool capped = false;
@@ -1106,8 +1111,9 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
             o.scale = scale;
             ok = true;
             if (has_twin[k] && !fallback)
-              recipes[k] = Recipe{steered_pattern, scale, cap, pose, miss_of(pose, fdp->vertex, along, value, false),
-                                  target_faults(pose_epidermis(model, pose), fdp->vertex).any(), false, std::string()};
+              (work[k].second ? second_recipes : recipes)[k] =
+                  Recipe{steered_pattern, scale, cap, pose, miss_of(pose, fdp->vertex, along, value, false),
+                         target_faults(pose_epidermis(model, pose), fdp->vertex).any(), false, std::string()};
           } else {
             // The target is then the most the group does at the cap. Where
             // the load control failed (the FDP moves the wrong way), a plain
@@ -1150,8 +1156,9 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
                   o.reached = reach / value;
                   o.message = reaches_message(o.reached, why);
                   if (has_twin[k] && !fallback && at_cap)
-                    recipes[k] = Recipe{steered_pattern, scale, cap, pose, miss_of(pose, fdp->vertex, along, value, true),
-                                        target_faults(pose_epidermis(model, pose), fdp->vertex).any(), true, why};
+                    (work[k].second ? second_recipes : recipes)[k] =
+                        Recipe{steered_pattern, scale, cap, pose, miss_of(pose, fdp->vertex, along, value, true),
+                               target_faults(pose_epidermis(model, pose), fdp->vertex).any(), true, why};
                 }
                 ok = true;
               }
@@ -1253,51 +1260,42 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     if (const int t = twin_of[order[j]]; t >= 0) after[j] = position[static_cast<size_t>(t)];
   std::mutex lock;
   int done = 0;
+  // Second groups (fap_mapping.h): a side its own group left short of the
+  // reference is made again with its second group in the same task, at
+  // once (a right twin's after its left twin's, as its own group's), and
+  // the target nearer the prescribed motion is kept (below). A pass after
+  // the others left one worker idle for most of its 0.3 s on Song.
+  std::vector<std::optional<Result>> own_group(work.size());  // where made again: the own group's
+  auto retry = [&](size_t k) {
+    const FapOutcome &o = results[k].outcome;
+    return options.second_groups && same_as[k] == k && work[k].fap && work[k].fap->driver == FapDriver::Muscles &&
+           !work[k].in_between && o.made && o.reached < 1 && o.prescribed.norm() > 0 &&
+           !second_group(model, *work[k].fap, work[k].side).empty();
+  };
   for_each_task_after(order.size(), options.threads, after, [&](size_t j) {
     const size_t k = order[j];
+    const std::string label = work[k].high ? high_level_label(*work[k].high) : fap_label(work[k].fap->fap, work[k].side);
     if (same_as[k] == k) make(k);
+    if (retry(k)) {
+      {
+        std::lock_guard<std::mutex> g(lock);
+        if (options.progress) options.progress(done, static_cast<int>(work.size()), label + " (second group)");
+      }
+      own_group[k] = std::move(results[k]);
+      results[k] = Result();
+      retried[k] = 1;
+      work[k].second = true;
+      make(k);
+      work[k].second = false;
+    }
     std::lock_guard<std::mutex> g(lock);
-    if (options.progress)
-      options.progress(++done, static_cast<int>(work.size()),
-                       work[k].high ? high_level_label(*work[k].high) : fap_label(work[k].fap->fap, work[k].side));
+    if (options.progress) options.progress(++done, static_cast<int>(work.size()), label);
   });
-  // Second groups (fap_mapping.h): a side its own group left short of the
-  // reference is made again with its second group (twins as before), and
-  // the target nearer the prescribed motion is kept.
   {
     auto miss = [](const FapOutcome &o) { return (o.achieved - o.prescribed).norm() / o.prescribed.norm(); };
-    std::vector<size_t> retry;
     for (size_t k : order) {
-      const FapOutcome &o = results[k].outcome;
-      if (options.second_groups && same_as[k] == k && work[k].fap && work[k].fap->driver == FapDriver::Muscles &&
-          !work[k].in_between && o.made && o.reached < 1 && o.prescribed.norm() > 0 &&
-          !second_group(model, *work[k].fap, work[k].side).empty())
-        retry.push_back(k);
-    }
-    std::vector<Result> own(retry.size());
-    std::vector<int> in_retry(work.size(), -1), after_retry(retry.size(), -1);
-    for (size_t j = 0; j < retry.size(); ++j) {
-      const size_t k = retry[j];
-      own[j] = std::move(results[k]);
-      results[k] = Result();
-      recipes[k].reset();
-      work[k].second = true;
-      in_retry[k] = static_cast<int>(j);
-    }
-    for (size_t j = 0; j < retry.size(); ++j)
-      if (const int t = twin_of[retry[j]]; t >= 0) after_retry[j] = in_retry[static_cast<size_t>(t)];
-    for_each_task_after(retry.size(), options.threads, after_retry, [&](size_t j) {
-      const size_t k = retry[j];
-      make(k);
-      std::lock_guard<std::mutex> g(lock);
-      if (options.progress)
-        options.progress(static_cast<int>(j + 1), static_cast<int>(retry.size()),
-                         fap_label(work[k].fap->fap, work[k].side) + " (second group)");
-    });
-    for (size_t j = 0; j < retry.size(); ++j) {
-      const size_t k = retry[j];
-      work[k].second = false;
-      FapOutcome &first = own[j].outcome, &second = results[k].outcome;
+      if (!own_group[k]) continue;
+      FapOutcome &first = own_group[k]->outcome, &second = results[k].outcome;
       std::string group;
       for (const FapContraction &c : second_group(model, *work[k].fap, work[k].side)) {
         char b[96];
@@ -1318,7 +1316,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
                         100 * second.reached, 100 * second.off_axis);
         first.message += "; its second group (" + group + ") came no nearer: " + b;
         first.seconds += second.seconds;
-        results[k] = std::move(own[j]);
+        results[k] = std::move(*own_group[k]);
       }
     }
   }

@@ -127,9 +127,10 @@
 //
 // Second groups (FapMapping::second_positive, _negative). A side whose own
 // group falls short of the reference is made again with its second group,
-// in a pass after the others (mirror twins as above), and the target whose
-// FDP lands nearer the prescribed motion (|achieved - prescribed|) is
-// kept, the other's outcome message saying so; a kept second group's
+// in the same task right after (mirror twins as above: a right side's
+// waits for its left twin's), and the target whose FDP lands nearer the
+// prescribed motion (|achieved - prescribed|) is kept, the other's
+// outcome message saying so; a kept second group's
 // target is the side's only one, reaching, then held, as any. Kept whole
 // rather than as an in-between past the own group's reach: Song's upper lip
 // sides (FAPs 8, 9, 55, 56) as in-betweens at the reference, 8 to 19 FAP
