@@ -486,9 +486,11 @@ Expected<SimMesh> make_sim_mesh(const Scene &scene, const FdpSet &fdps, const Si
   dec.add(distance);
   dec.add(aspect);
   dec.module(length).sizing = [&features, reach](const Eigen::Vector3d &x) {
-    double d = std::numeric_limits<double>::infinity();
-    for (const Eigen::Vector3d &f : features) d = std::min(d, (x - f).norm());
-    return kFeatureSizing + (1 - kFeatureSizing) * std::min(1.0, d / reach);
+    // One square root for the nearest: the same distance (sqrt is monotone),
+    // without one per feature in every collapse's priority.
+    double d2 = std::numeric_limits<double>::infinity();
+    for (const Eigen::Vector3d &f : features) d2 = std::min(d2, (x - f).squaredNorm());
+    return kFeatureSizing + (1 - kFeatureSizing) * std::min(1.0, std::sqrt(d2) / reach);
   };
   // In [0, 1): height first, then depth, then distance from the mid-plane.
   const double extent = std::max((hi - lo).maxCoeff(), 1e-12);
@@ -583,7 +585,7 @@ Expected<std::vector<int>> muscle_key_vertices(const Scene &scene, const FdpSet 
   const int skin = scene.find_kind(PartKind::Skin);
   if (skin < 0) return Status::error("no skin part: no part holds FDP 2.1 (chin)");
   if (Status s = check_skin(scene, skin); !s) return s;
-  Expected<SkinModel> t = build_skin_model(scene, skin, tissue);
+  Expected<SkinModel> t = build_skin_model(scene, skin, tissue, SkinBuild::Surfaces);
   if (!t) return t.status();
   std::vector<int> out;
   auto add = [&](int node) {

@@ -235,12 +235,20 @@ std::vector<EyeSphere> fit_eyeballs(const Scene &scene);
 std::vector<int8_t> near_eyeballs(const Eigen::MatrixXd &V, const std::vector<uint8_t> &used,
                                   const std::vector<EyeSphere> &eyes, double band = 0.5);
 
+// What build_skin_model fills in: the whole tissue, or its surfaces alone
+// (SkinModel::springs, node_springs and mass left empty): enough to place
+// the muscles on (muscles.h), as muscle_key_vertices (sim_mesh.h) does on
+// the whole skin before the decimation (Song's: 1.3 ms instead of 43; the
+// 10k head's 3.4 instead of 165).
+enum class SkinBuild { Tissue, Surfaces };
+
 // Builds the tissue for scene part `part`; the scene's eye parts (if any)
 // become its eyeballs (fit_eyeballs, near_eyeballs). Fails when the part has no
 // triangles, when its centre of gravity is on the surface (not a closed-ish
 // head), or when parameters are out of range (depths not 0 < d1 < d2 < 1,
 // skull_scale not in (0, 1)).
-Expected<SkinModel> build_skin_model(const Scene &scene, int part, const TissueParams &params);
+Expected<SkinModel> build_skin_model(const Scene &scene, int part, const TissueParams &params,
+                                     SkinBuild build = SkinBuild::Tissue);
 
 // The node of `layer` nearest p (global node index), among vertices used by
 // a triangle; -1 when there are none.
