@@ -12,6 +12,7 @@
 #include <iterator>
 #include <map>
 #include <memory>
+#include <set>
 #include <tuple>
 
 #include "anatomy/face_model.h"
@@ -329,6 +330,67 @@ TEST(SkinModel, FourScaledSurfacesAndResolutionFreeStiffness) {
     }
   }
   EXPECT_GT(freed, 0);
+}
+
+// Each node pair that a prism's edges join (its two triangles' edges, the
+// bone's left out, the connecting and the crossed ones) is one spring, and
+// no other pair is; the surfaces alone (SkinBuild::Surfaces, for the
+// muscles' key vertices before the decimation) are the whole tissue's
+// surfaces, and the muscles land on the same nodes and areas on both.
+TEST(SkinModel, EachNodePairIsOneSpringAndTheSurfacesAloneAreTheTissues) {
+  const Built &b = head_1k();
+  const Scene &scene = b.head.scene;
+  const int part = b.model.skin;
+  Expected<SkinModel> whole = build_skin_model(scene, part, b.model.tissue.params);
+  Expected<SkinModel> surfaces = build_skin_model(scene, part, b.model.tissue.params, SkinBuild::Surfaces);
+  ASSERT_TRUE(whole) << whole.status().message();
+  ASSERT_TRUE(surfaces) << surfaces.status().message();
+  std::set<std::pair<int, int>> pairs;
+  auto join = [&](int a, int c) { pairs.insert({std::min(a, c), std::max(a, c)}); };
+  for (int f = 0; f < whole->F.rows(); ++f)
+    for (int slab = 0; slab < 3; ++slab)
+      for (int k = 0; k < 3; ++k) {
+        const int u = whole->F(f, k), w = whole->F(f, (k + 1) % 3);
+        join(whole->node(slab, u), whole->node(slab, w));
+        if (slab < 2) join(whole->node(slab + 1, u), whole->node(slab + 1, w));
+        join(whole->node(slab, u), whole->node(slab + 1, u));
+        join(whole->node(slab, u), whole->node(slab + 1, w));
+        join(whole->node(slab, w), whole->node(slab + 1, u));
+      }
+  std::set<std::pair<int, int>> springs;
+  for (const Spring &sp : whole->springs) {
+    EXPECT_TRUE(springs.insert({std::min(sp.a, sp.b), std::max(sp.a, sp.b)}).second) << sp.a << "-" << sp.b;
+  }
+  EXPECT_EQ(whole->springs.size(), pairs.size());
+  EXPECT_TRUE(springs == pairs);
+  for (size_t i = 0; i < whole->node_springs.size(); ++i)
+    for (int q : whole->node_springs[i]) {
+      const Spring &sp = whole->springs[static_cast<size_t>(q)];
+      EXPECT_TRUE(sp.a == static_cast<int>(i) || sp.b == static_cast<int>(i));
+    }
+
+  EXPECT_TRUE(surfaces->springs.empty());
+  EXPECT_TRUE(surfaces->node_springs.empty());
+  EXPECT_EQ(surfaces->mass.size(), 0);
+  EXPECT_TRUE(surfaces->X0 == whole->X0);
+  EXPECT_TRUE(surfaces->normal == whole->normal);
+  EXPECT_TRUE(surfaces->thickness == whole->thickness);
+  EXPECT_TRUE(surfaces->neighbours == whole->neighbours);
+  EXPECT_TRUE(surfaces->eye_of == whole->eye_of);
+  EXPECT_TRUE(surfaces->eye_near == whole->eye_near);
+  EXPECT_TRUE(surfaces->skull_free == whole->skull_free);
+  int placed = 0;
+  for (size_t d = 0; d < muscle_table().size(); ++d) {
+    Expected<Muscle> on_whole = place_muscle(*whole, b.model.fdps, static_cast<int>(d));
+    Expected<Muscle> on_surfaces = place_muscle(*surfaces, b.model.fdps, static_cast<int>(d));
+    ASSERT_EQ(static_cast<bool>(on_whole), static_cast<bool>(on_surfaces)) << muscle_table()[d].name;
+    if (!on_whole) continue;
+    ++placed;
+    EXPECT_EQ(on_whole->node_a, on_surfaces->node_a) << on_whole->name;
+    EXPECT_EQ(on_whole->node_b, on_surfaces->node_b) << on_whole->name;
+    EXPECT_EQ(on_whole->influence, on_surfaces->influence) << on_whole->name;
+  }
+  EXPECT_GE(placed, 25);
 }
 
 // turned_slabs() finds a layer pushed through itself, and leaves out the
