@@ -402,13 +402,9 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
   auto estimate = [&] {
     // One rest factorisation of the connected skin serves every muscle's
     // estimate; where it is singular (a skin piece that nothing holds),
-    // each muscle grows its own set instead.
-    {
-      FactorCache whole;
-      for (size_t k = 0; k < todo.size(); ++k) sets[k] = wave_estimate(model, model.muscles[todo[k]], &whole);
-    }
-    for (size_t k = 0; k < todo.size(); ++k)
-      if (!sets[k]) sets[k] = wave_estimate(model, model.muscles[todo[k]], nullptr);
+    // each muscle grows its own set instead, in its own task (below).
+    FactorCache whole;
+    for (size_t k = 0; k < todo.size(); ++k) sets[k] = wave_estimate(model, model.muscles[todo[k]], &whole);
     for (size_t k = 0; k < todo.size(); ++k) order[k] = k;
     std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
       if ((twin_task[a] >= 0) != (twin_task[b] >= 0)) return twin_task[b] >= 0;
@@ -444,6 +440,7 @@ Expected<FaceModel> build_face_model(const Scene &scene, const FdpSet &input, co
         calibrated_one.wait(g, [&] { return calibrated[static_cast<size_t>(t)] != 0; });
       }
       Expected<std::vector<int>> &set = sets[k];
+      if (!set) set = wave_estimate(model, m, nullptr);
       Status s = set ? Status::ok() : set.status().wrap("calibrating " + m.name);
       // A muscle whose tissue locks before its key node reaches the
       // table's range, whose pose there tears the skin, or where the solver
