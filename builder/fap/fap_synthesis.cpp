@@ -733,7 +733,8 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
   // (work[k].second): a right twin's second group starts from its left
   // twin's second recipe where the left one was made again too.
   std::vector<std::optional<Recipe>> recipes(work.size()), second_recipes(work.size());
-  std::vector<char> retried(work.size(), 0);  // made again with its second group
+  // Where a side is made again with its second group: its own group's result.
+  std::vector<std::optional<Result>> own_group(work.size());
   auto miss_of = [&skin](const Pose &p, int vertex, const Eigen::Vector3d &along, double value, bool capped) {
     const int node = skin.node(kEpidermis, vertex);
     const Eigen::Vector3d m = (p.X.row(node) - skin.X0.row(node)).transpose();
@@ -1003,10 +1004,13 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         // A right FAP whose left twin left a recipe: that mirrored first
         // (from_twin). Else, or where that pose is worse than the twin's, the
         // target is made as any other.
-        const size_t tw = static_cast<size_t>(std::max(twin_of[k], 0));
-        const std::optional<Recipe> &twin_recipe = work[k].second && retried[tw] ? second_recipes[tw] : recipes[tw];
-        if (twin_of[k] >= 0 && twin_recipe)
-          ok = from_twin(*twin_recipe, pattern, action, value, unit, along, fdp->vertex, &cache, pose, o);
+        // (Read only for a right FAP: its left twin's task has finished.)
+        if (const int tw = twin_of[k]; tw >= 0) {
+          const size_t t = static_cast<size_t>(tw);
+          const std::optional<Recipe> &twin_recipe = work[k].second && own_group[t] ? second_recipes[t] : recipes[t];
+          if (twin_recipe)
+            ok = from_twin(*twin_recipe, pattern, action, value, unit, along, fdp->vertex, &cache, pose, o);
+        }
         if (!ok) {
           double scale = 0;
           bool capped = false;
@@ -1264,8 +1268,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
   // reference is made again with its second group in the same task, at
   // once (a right twin's after its left twin's, as its own group's), and
   // the target nearer the prescribed motion is kept (below). A pass after
-  // the others left one worker idle for most of its 0.3 s on Song.
-  std::vector<std::optional<Result>> own_group(work.size());  // where made again: the own group's
+  // the others left a worker idle for part of its 0.3 s on Song.
   auto retry = [&](size_t k) {
     const FapOutcome &o = results[k].outcome;
     return options.second_groups && same_as[k] == k && work[k].fap && work[k].fap->driver == FapDriver::Muscles &&
@@ -1283,7 +1286,6 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       }
       own_group[k] = std::move(results[k]);
       results[k] = Result();
-      retried[k] = 1;
       work[k].second = true;
       make(k);
       work[k].second = false;

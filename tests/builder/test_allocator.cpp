@@ -1,6 +1,7 @@
 // core/allocator.h: a block freed is reused without the kernel's page faults.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <memory>
