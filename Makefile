@@ -52,29 +52,35 @@ FORMAT_SRC := $(wildcard formats/src/*.c)
 DRACO_SRC := $(wildcard formats/draco/*.cpp)
 BUILDER_SRC := $(filter-out builder/tools/%,$(wildcard builder/*/*.cpp))
 PLAYER_SRC := $(wildcard player_c/src/*.c)
-RENDER_SRC := $(wildcard ports/osmesa/src/*.c ports/osmesa/src/*.cpp)
+# The OSMesa context and the GL drawing it needs, built as a shared object
+# that render.c loads on the first picture (ports/osmesa/src/osmesa_plugin.h):
+# programs that draw nothing never map libOSMesa and libLLVM.
+OSMESA_ONLY_SRC := ports/osmesa/src/osmesa_plugin.c
+OSMESA_PLUGIN_SRC := $(OSMESA_ONLY_SRC) $(addprefix ports/osmesa/src/,gl_draw.c render_view.c render_error.c)
+RENDER_SRC := $(filter-out $(OSMESA_ONLY_SRC),$(wildcard ports/osmesa/src/*.c ports/osmesa/src/*.cpp))
 
 FORMAT_LIB := $(B)/lib/libafm_format.a
 DRACO_LIB := $(B)/lib/libafm_draco.a
 BUILDER_LIB := $(B)/lib/libafm_builder.a
 PLAYER_LIB := $(B)/lib/libafm_player.a
 RENDER_LIB := $(B)/lib/libafm_render.a
+OSMESA_PLUGIN := $(B)/lib/libafm_osmesa.so
 
 obj = $(patsubst %,$(B)/obj/%.o,$(1))
 
 LIBS := $(FORMAT_LIB) $(DRACO_LIB) $(BUILDER_LIB) \
-  $(if $(PLAYER_SRC),$(PLAYER_LIB)) $(if $(RENDER_SRC),$(RENDER_LIB))
+  $(if $(PLAYER_SRC),$(PLAYER_LIB)) $(if $(RENDER_SRC),$(RENDER_LIB) $(OSMESA_PLUGIN))
 
 # Link order: dependants first.
 CXX_LINK_LIBS := $(BUILDER_LIB) $(if $(RENDER_SRC),$(RENDER_LIB)) \
   $(if $(PLAYER_SRC),$(PLAYER_LIB)) $(DRACO_LIB) $(FORMAT_LIB) \
-  -lOpenMeshTools -lOpenMeshCore -ldraco -lOSMesa -lpng -lpthread -lm
+  -lOpenMeshTools -lOpenMeshCore -ldraco -lpng -lpthread -lm
 # C tools link as plain C programs: the Draco codec only needs libdraco and
 # libstdc++ beside it.
 C_LINK_LIBS := $(if $(PLAYER_SRC),$(PLAYER_LIB)) $(DRACO_LIB) $(FORMAT_LIB) -ldraco -lstdc++ -lm
 # The desktop preview draws through GLFW's libGL, never libOSMesa: both define
 # the gl* functions. From libafm_render it takes the GL drawing (gl_draw.c),
-# the face scene and the PNG writer; not render.c, which would need OSMesa.
+# the face scene and the PNG writer; not render.c, whose renderer is OSMesa's.
 GLFW_LIBS := $(RENDER_LIB) $(PLAYER_LIB) $(DRACO_LIB) $(FORMAT_LIB)
 GLFW_LINK_LIBS := $(GLFW_LIBS) -ldraco -lglfw -lGL -lpng -lm
 
@@ -104,6 +110,16 @@ $(B)/lib/%.a:
 	@mkdir -p $(@D)
 	@rm -f $@
 	$(AR) rcs $@ $^
+
+# Position-independent, hidden but for the plugin's entry; -z defs: every
+# symbol resolved at link time, not at the first picture.
+$(OSMESA_PLUGIN): $(patsubst %,$(B)/pic/%.o,$(OSMESA_PLUGIN_SRC))
+	@mkdir -p $(@D)
+	$(CC) -shared $^ -o $@ $(LDFLAGS) -Wl,-z,defs -lOSMesa -lm
+
+$(B)/pic/%.c.o: %.c
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS) -fPIC -fvisibility=hidden -c $< -o $@
 
 $(B)/obj/%.c.o: %.c
 	@mkdir -p $(@D)
@@ -279,4 +295,4 @@ fuzz: deps
 -include $(shell find $(ARM_DIR) $(FUZZ_DIR)/obj -name '*.d' 2>/dev/null)
 # ==== end of the ARM, size and fuzzing block ==================================
 
--include $(shell find $(B)/obj -name '*.d' 2>/dev/null)
+-include $(shell find $(B)/obj $(B)/pic -name '*.d' 2>/dev/null)

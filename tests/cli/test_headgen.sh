@@ -25,6 +25,36 @@ sig=$(od -An -tx1 -N8 "$tmp/b.png" 2>/dev/null | tr -d ' \n')
 ihdr=$(od -An -tx1 -j16 -N8 "$tmp/b.png" 2>/dev/null | tr -d ' \n')
 [ "$ihdr" = "0000016800000096" ] || fail "b.png is not 360x150 (IHDR $ihdr)"
 
+# The renderer (libOSMesa, which brings libLLVM) is a shared object loaded
+# for the first picture (ports/osmesa/src/osmesa_plugin.h). The loader's own
+# trace (LD_DEBUG=files lists every object it maps, dlopen'ed or not) shows
+# it mapped for the run above with a picture, and not for a run without one.
+LD_DEBUG=files "$bin" --vertices 1000 -o "$tmp/p.wrl" --render "$tmp/p.png" --size 40x40 \
+  >/dev/null 2>"$tmp/ld.txt" || fail "a run with a picture failed under LD_DEBUG"
+grep -q "file=libafm_osmesa.so\|file=.*/libafm_osmesa.so" "$tmp/ld.txt" ||
+  fail "LD_DEBUG=files does not show the renderer loaded for a picture"
+grep -q "file=libOSMesa" "$tmp/ld.txt" || fail "LD_DEBUG=files does not show libOSMesa for a picture"
+LD_DEBUG=files "$bin" --vertices 1000 -o "$tmp/q.wrl" >/dev/null 2>"$tmp/ld.txt" ||
+  fail "a run without a picture failed under LD_DEBUG"
+grep -q "libOSMesa\|libafm_osmesa\|libLLVM" "$tmp/ld.txt" &&
+  fail "a run without a picture loaded $(grep -o 'file=[^ ]*\(OSMesa\|osmesa\|LLVM\)[^ ]*' "$tmp/ld.txt" | sort -u | tr '\n' ' ')"
+# A renderer that cannot be loaded: exit 1, its path and why, no picture.
+AFM_OSMESA_PLUGIN="$tmp/no-renderer.so" "$bin" --vertices 1000 -o "$tmp/r.wrl" \
+  --render "$tmp/r.png" >/dev/null 2>"$tmp/err.txt"
+[ $? -eq 1 ] || fail "a missing renderer does not exit 1"
+grep -q "cannot load the OSMesa renderer: .*no-renderer.so" "$tmp/err.txt" ||
+  fail "a missing renderer: '$(cat "$tmp/err.txt")'"
+[ -e "$tmp/r.png" ] && fail "a missing renderer left a picture"
+# A shared object that is not the renderer (libpng, which the tool maps anyway).
+png_so=$(ldd "$bin" | awk '/libpng/ { print $3; exit }')
+[ -n "$png_so" ] || fail "ldd finds no libpng in $bin"
+AFM_OSMESA_PLUGIN="$png_so" "$bin" --vertices 1000 -o "$tmp/r.wrl" --render "$tmp/r.png" \
+  >/dev/null 2>"$tmp/err.txt"
+[ $? -eq 1 ] || fail "a foreign shared object as the renderer does not exit 1"
+grep -q "is not the AFM OSMesa renderer (it has no afm_osmesa_plugin_get)" "$tmp/err.txt" ||
+  fail "a foreign renderer: '$(cat "$tmp/err.txt")'"
+[ -e "$tmp/r.png" ] && fail "a foreign renderer left a picture"
+
 # Bad usage: exit 2, a message that says what is wrong, nothing written.
 check_usage() {
   name=$1 pattern=$2

@@ -24,7 +24,7 @@ if ! make --no-print-directory -s install config="$config" B="$AFM_BUILD" PREFIX
   echo "FAIL: make install"; cat "$tmp/install.log"; exit 1
 fi
 for f in bin/afm-info bin/afm-import include/afm/format.h include/afm/draco.h \
-         lib/libafm_format.a lib/libafm_draco.a lib/pkgconfig/afm-player.pc; do
+         lib/libafm_format.a lib/libafm_draco.a lib/libafm_osmesa.so lib/pkgconfig/afm-player.pc; do
   [ -e "$tmp/prefix/$f" ] || { echo "FAIL: $f not installed"; exit 1; }
 done
 
@@ -69,7 +69,10 @@ cc -std=c99 -Wall -Werror $san "$tmp/reader.c" -o "$tmp/reader" $flags || { echo
 cc -std=c99 -Wall -Werror $san -DWITH_DRACO "$tmp/reader.c" -o "$tmp/reader-draco" \
   -L"$tmp/prefix/lib" -lafm_draco $flags -ldraco -lstdc++ -lm || { echo "FAIL: compile with Draco"; exit 1; }
 
-"$tmp/prefix/bin/afm-headgen" --vertices 1000 -o "$tmp/h.obj" --fdp "$tmp/h.fdp" >/dev/null &&
+# --render: the installed tool finds its renderer in the prefix's lib/.
+"$tmp/prefix/bin/afm-headgen" --vertices 1000 -o "$tmp/h.obj" --fdp "$tmp/h.fdp" \
+    --render "$tmp/h.png" --size 40x40 >/dev/null &&
+  [ -s "$tmp/h.png" ] &&
   "$tmp/prefix/bin/afm-import" "$tmp/h.obj" "$tmp/h.fdp" -o "$tmp/h.afm" >/dev/null &&
   "$tmp/prefix/bin/afm-pack" --draco "$tmp/h.afm" "$tmp/h-draco.afm" >/dev/null ||
   { echo "FAIL: installed tools"; exit 1; }

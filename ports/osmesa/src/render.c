@@ -1,98 +1,133 @@
-/* Offscreen mesh rendering through OSMesa (software OpenGL 2.1+ with GLSL
- * 1.20 in a compatibility context): the context and its buffer. The drawing
- * itself is gl_draw.c, shared with the desktop preview. See afm/render.h. */
+/* afm/render.h's renderer: loads the OSMesa context (libafm_osmesa.so,
+ * osmesa_plugin.h says why) on the first afm_renderer_create and forwards to
+ * it. A program that never draws never maps libOSMesa or libLLVM. */
+#define _GNU_SOURCE 1 /* readlink */
+
 #include "afm/render.h"
 
-#include <GL/gl.h>
-#include <GL/osmesa.h>
+#include <dlfcn.h>
+#include <limits.h>
+#include <stdio.h>
+#include <pthread.h>
 #include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
 
-#include "afm/gl_draw.h"
+#include "osmesa_plugin.h"
 #include "render_error.h"
 
-struct afm_renderer {
-  OSMesaContext ctx;
-  uint8_t *buffer; /* (width * s) x (height * s) RGBA, bottom row first */
-  int buf_w, buf_h;
-  afm_gl_drawer *drawer; /* made on the first draw, with the context current */
-};
+#ifndef PATH_MAX
+#define PATH_MAX 4096
+#endif
+
+static pthread_once_t load_once = PTHREAD_ONCE_INIT;
+static const afm_osmesa_plugin *plugin;
+static afm_result load_result;
+static char load_error[PATH_MAX + 512];
+
+/* Opens `path` and checks its table; on failure, says why in load_error.
+ * `hint`: how to point the loader elsewhere, for a file it could not open. */
+static const afm_osmesa_plugin *open_plugin(const char *path, const char *hint,
+                                            afm_result *result) {
+  /* RTLD_LOCAL: the object's GL symbols stay its own. Never closed: OSMesa
+   * keeps state for the process, and the sanitizers symbolise its frames. */
+  void *handle = dlopen(path, RTLD_NOW | RTLD_LOCAL);
+  afm_osmesa_plugin_fn entry;
+  const afm_osmesa_plugin *table;
+  const char *why;
+  if (!handle) {
+    why = dlerror(); /* glibc's names the file */
+    *result = AFM_ERR_IO;
+    snprintf(load_error, sizeof load_error, "cannot load the OSMesa renderer: %s%s",
+             why ? why : path, hint);
+    return NULL;
+  }
+  /* POSIX's sanctioned way from a data pointer to a function pointer. */
+  *(void **)&entry = dlsym(handle, AFM_OSMESA_PLUGIN_ENTRY);
+  table = entry ? entry() : NULL;
+  if (!table) {
+    *result = AFM_ERR_VERSION;
+    snprintf(load_error, sizeof load_error,
+             "%s is not the AFM OSMesa renderer (it has no %s)", path, AFM_OSMESA_PLUGIN_ENTRY);
+  } else if (table->version != AFM_OSMESA_PLUGIN_VERSION ||
+             table->mesh_size != sizeof(afm_render_mesh) ||
+             table->view_size != sizeof(afm_render_view)) {
+    *result = AFM_ERR_VERSION;
+    snprintf(load_error, sizeof load_error,
+             "the OSMesa renderer %s is from another build (version %d, expected %d): "
+             "rebuild or reinstall it",
+             path, table->version, AFM_OSMESA_PLUGIN_VERSION);
+  } else {
+    return table;
+  }
+  dlclose(handle);
+  return NULL;
+}
+
+/* Where to look: $AFM_OSMESA_PLUGIN when set; else beside the program's own
+ * directory, in ../lib (the build tree's bin/, tests/ and bench/, and an
+ * installed prefix's bin/ all sit next to lib/); else the dynamic loader's
+ * search path. */
+static void load_plugin(void) {
+  char path[PATH_MAX + 64];
+  const char *env = getenv("AFM_OSMESA_PLUGIN");
+  ssize_t n;
+  char *slash;
+  if (env && env[0]) {
+    plugin = open_plugin(env, "", &load_result);
+    return;
+  }
+  n = readlink("/proc/self/exe", path, PATH_MAX);
+  if (n > 0 && n < PATH_MAX) {
+    path[n] = '\0';
+    slash = strrchr(path, '/');
+    if (slash) {
+      strcpy(slash + 1, "../lib/" AFM_OSMESA_PLUGIN_FILE);
+      if (access(path, F_OK) == 0) {
+        plugin = open_plugin(path, "", &load_result);
+        return;
+      }
+    }
+  }
+  plugin = open_plugin(AFM_OSMESA_PLUGIN_FILE,
+                       " (not in ../lib beside the program either: set AFM_OSMESA_PLUGIN to "
+                       "its path)",
+                       &load_result);
+}
+
+static afm_result need_plugin(void) {
+  pthread_once(&load_once, load_plugin);
+  if (!plugin) return render_fail(load_result, "%s", load_error);
+  return AFM_OK;
+}
+
+/* A failure inside the object: its message, in this side's last error. */
+static afm_result forward_failure(afm_result result) {
+  if (result != AFM_OK) render_fail(result, "%s", plugin->last_error());
+  return result;
+}
 
 afm_result afm_renderer_create(afm_renderer **out) {
-  afm_renderer *r;
+  afm_result res;
   render_clear_error();
   if (!out) return render_fail(AFM_ERR_ARGUMENT, "afm_renderer_create: out is NULL");
   *out = NULL;
-  r = (afm_renderer *)calloc(1, sizeof *r);
-  if (!r) return render_fail(AFM_ERR_OUT_OF_MEMORY, "out of memory for the renderer");
-  r->ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 0, 0, NULL);
-  if (!r->ctx) {
-    free(r);
-    return render_fail(AFM_ERR_LIMIT, "OSMesa cannot create an RGBA context with a 24-bit depth buffer");
-  }
-  *out = r;
-  return AFM_OK;
+  res = need_plugin();
+  if (res != AFM_OK) return res;
+  return forward_failure(plugin->renderer_create(out));
 }
 
 void afm_renderer_destroy(afm_renderer *r) {
-  if (!r) return;
-  /* Unbind first: Mesa keeps the framebuffer of a context that is still
-   * current when it is destroyed. The shader program and textures belong to
-   * the context and go with it. */
-  if (OSMesaGetCurrentContext() == r->ctx) OSMesaMakeCurrent(NULL, NULL, GL_UNSIGNED_BYTE, 0, 0);
-  OSMesaDestroyContext(r->ctx);
-  afm_gl_drawer_destroy(r->drawer);
-  free(r->buffer);
-  free(r);
-}
-
-static afm_result ensure_buffer(afm_renderer *r, int w, int h) {
-  GLint maxw = 0, maxh = 0;
-  if (w != r->buf_w || h != r->buf_h) {
-    uint8_t *b = (uint8_t *)realloc(r->buffer, (size_t)w * (size_t)h * 4);
-    if (!b) return render_fail(AFM_ERR_OUT_OF_MEMORY, "out of memory for a %dx%d image", w, h);
-    r->buffer = b;
-    r->buf_w = w;
-    r->buf_h = h;
-  }
-  if (!OSMesaMakeCurrent(r->ctx, r->buffer, GL_UNSIGNED_BYTE, w, h))
-    return render_fail(AFM_ERR_LIMIT, "OSMesa cannot render a %dx%d image", w, h);
-  OSMesaGetIntegerv(OSMESA_MAX_WIDTH, &maxw);
-  OSMesaGetIntegerv(OSMESA_MAX_HEIGHT, &maxh);
-  if ((maxw > 0 && w > maxw) || (maxh > 0 && h > maxh))
-    return render_fail(AFM_ERR_LIMIT, "a %dx%d image is larger than OSMesa's %dx%d", w, h,
-                       (int)maxw, (int)maxh);
-  if (!r->drawer) return afm_gl_drawer_create(&r->drawer);
-  return AFM_OK;
+  /* A renderer exists only when the object loaded. */
+  if (r) plugin->renderer_destroy(r);
 }
 
 afm_result afm_renderer_draw(afm_renderer *r, const afm_render_mesh *meshes, size_t mesh_count,
                              const afm_render_view *view, uint8_t *rgba_out) {
-  int s;
-  afm_result res;
   render_clear_error();
-  if (!r || !view || !rgba_out || (!meshes && mesh_count))
-    return render_fail(AFM_ERR_ARGUMENT, "afm_renderer_draw: NULL argument");
-  if (view->width <= 0 || view->height <= 0 || view->width > 8192 || view->height > 8192)
-    return render_fail(AFM_ERR_ARGUMENT, "image size %dx%d is not in 1..%d", view->width,
-                       view->height, 8192);
-  s = afm_gl_supersample(view);
-  res = ensure_buffer(r, view->width * s, view->height * s);
-  if (res != AFM_OK) return res;
-  res = afm_gl_draw(r->drawer, meshes, mesh_count, view, s);
-  if (res != AFM_OK) return res;
-  afm_gl_resolve(r->buffer, view->width, view->height, s, rgba_out);
-  return AFM_OK;
+  if (!r) return render_fail(AFM_ERR_ARGUMENT, "afm_renderer_draw: NULL argument");
+  return forward_failure(plugin->renderer_draw(r, meshes, mesh_count, view, rgba_out));
 }
-
-/* Mesa's OSMesa (22.x) keeps a few hundred bytes per context that
- * OSMesaDestroyContext does not free (its framebuffer list). LeakSanitizer
- * (the sanitize build) reads its default suppressions from this hook, so
- * every program that renders gets it; weak, so a program can define its
- * own. Harmless without the sanitizers. */
-#if defined(__GNUC__)
-const char *__lsan_default_suppressions(void) __attribute__((weak));
-const char *__lsan_default_suppressions(void) { return "leak:libOSMesa.so\n"; }
-#endif
 
 afm_result afm_render(const afm_render_mesh *meshes, size_t mesh_count,
                       const afm_render_view *view, uint8_t *rgba_out) {
@@ -103,3 +138,14 @@ afm_result afm_render(const afm_render_mesh *meshes, size_t mesh_count,
   afm_renderer_destroy(r);
   return res;
 }
+
+/* Mesa's OSMesa (22.x) keeps a few hundred bytes per context that
+ * OSMesaDestroyContext does not free (its framebuffer list). LeakSanitizer
+ * (the sanitize build) reads its default suppressions from this hook, which
+ * must be in the program, not in the loaded object: so every program that
+ * renders gets it. Weak, so a program can define its own. Harmless without
+ * the sanitizers. */
+#if defined(__GNUC__)
+const char *__lsan_default_suppressions(void) __attribute__((weak));
+const char *__lsan_default_suppressions(void) { return "leak:libOSMesa.so\n"; }
+#endif

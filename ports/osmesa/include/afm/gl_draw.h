@@ -4,9 +4,9 @@
  * (ports/glfw, a GLFW window), so both draw the same picture.
  *
  * This code calls OpenGL 2.1 with GLSL 1.20 in a compatibility context and
- * binds to whichever GL library the program links: libOSMesa (afm-render)
- * or libGL (afm-view); never both in one program, since each defines the
- * gl* functions.
+ * binds to whichever GL library it is linked with: libOSMesa (inside the
+ * renderer's shared object, libafm_osmesa.so) or libGL (afm-view); never
+ * both in one object, since each defines the gl* functions.
  *
  * Meshes, views and their conventions: afm/render.h. Errors: afm_result, and
  * afm_render_last_error() explains.
