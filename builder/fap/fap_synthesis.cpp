@@ -1098,6 +1098,17 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
             } else {
               pz = std::move(beyond);
               scale = s2, capped = capped2, cap = kMaxFapScale;
+              if (capped) {
+                // Still short at the cap, the skin a face: once more from
+                // there, up to kFurtherFapScale.
+                double s4 = 0;
+                bool capped4 = false;
+                Expected<Pose> further = past_range(kFurtherFapScale, &s4, &capped4);
+                if (further && !target_faults(pose_epidermis(model, *further), fdp->vertex).any()) {
+                  pz = std::move(further);
+                  scale = s4, capped = capped4, cap = kFurtherFapScale;
+                }
+              }
             }
           }
           // Where the group's pose drifts off the FAP's direction, helpers
@@ -1125,7 +1136,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
             const std::string why = !pz                 ? pz.status().message()
                                     : !beyond_why.empty() ? "the table's contractions reach less, and " + beyond_why
                                                           : "the group reaches less at " +
-                                                                std::to_string(static_cast<int>(kMaxFapScale)) +
+                                                                std::to_string(static_cast<int>(cap)) +
                                                                 " times the table's contractions";
             const bool at_cap = static_cast<bool>(pz);
             Expected<Pose> full = std::move(pz);

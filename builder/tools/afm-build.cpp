@@ -99,6 +99,7 @@ void usage(FILE *out) {
       "                          FDP motion and the error along and off the FAP's\n"
       "                          direction (a muscle group short of the FAP's reference\n"
       "                          may pass its calibrated range, up to %g\n"
+      "                          times, and a weak one still short there up to %g\n"
       "                          times, while the skin stays a face once the few slivers\n"
       "                          it turns are untangled, as the target stores them (raw\n"
       "                          at the lip corners); where a side falls\n"
@@ -150,7 +151,8 @@ void usage(FILE *out) {
       "\n"
       "Exit status: 0 on success (FAPs that cannot be made are reported, not fatal), 1\n"
       "on bad input, an output that cannot be written or a solve that does not\n"
-      "converge (the message says which and why), 2 on bad usage.\n", kCollapseFloor, kDefaultSimVertices, kMaxFapScale);
+      "converge (the message says which and why), 2 on bad usage.\n", kCollapseFloor, kDefaultSimVertices, kMaxFapScale,
+      kFurtherFapScale);
 }
 
 bool stderr_is_terminal() {
