@@ -1721,18 +1721,20 @@ TEST(FapSynthesis, TheNoseTipGoesUpDownAndSidewaysByItsReference) {
 // lips too (fap_mapping.cpp), and the side reaches its reference. On the
 // 2,000-vertex head, whose upper lip muscles cover 4 vertices, the muscles
 // alone took 2.2 38 % of the way; here the 1k head's FAP unit (MNS0) is
-// taken 3 times longer, so that its own group falls short as well.
+// taken 4 times longer, so that its own group falls short as well (72 % at
+// eight times its range; 3 times longer, it reaches its reference alone
+// past four times, kFurtherFapScale; 5 times, the second group falls short).
 TEST(FapSynthesis, TheUpperLipsMiddleRaisedReachesWithOrbicularisOrisParting) {
   const Built &b = head_1k();
   FaceModel m = b.model;
-  m.fapu.mns0 *= 3;
+  m.fapu.mns0 *= 4;
   FapSynthesisOptions o;
   o.only = {4};
   Expected<FapSynthesis> syn = synthesize_faps(b.head.scene, m, o);
   ASSERT_TRUE(syn.is_ok()) << syn.status().message();
   const FapOutcome *raised = made_at(*syn, 4, -find_fap_mapping(4)->reference);
   ASSERT_NE(raised, nullptr) << "no target for FAP 4's negative side";
-  std::printf("FAP 4 at %d, the 1k head's MNS0 3 times longer: %.0f %% of the prescribed motion, %.1f %% off "
+  std::printf("FAP 4 at %d, the 1k head's MNS0 4 times longer: %.0f %% of the prescribed motion, %.1f %% off "
               "the direction (%s)\n",
               raised->reference, 100 * raised->reached, 100 * raised->off_axis, raised->message.c_str());
   EXPECT_NE(raised->message.find("made with its second group"), std::string::npos) << raised->message;
@@ -3089,9 +3091,10 @@ std::vector<double> played_along(const afm_doc &doc, int group, int index, const
 }
 
 // Reach, then hold (fap_synthesis.h). With the 1k head's FAP unit (ENS0)
-// taken 8 times longer, the nose's benders bend the tip (FAP 64) by a share
-// of its reference, either way, and reach no further at 4 times their
-// range. (Until the benders came, nasalis did so at the head's own unit.)
+// taken 16 times longer, the nose's benders bend the tip (FAP 64) by a share
+// of its reference, either way (20 of 60), and reach no further at 8 times
+// their range (kFurtherFapScale; 8 times longer took them to 39 at 4, and to
+// the reference past it). (Until the benders came, nasalis did so at the head's own unit.)
 // Each side's pose is then stored at the whole FAP units it reaches, and
 // held from there to the reference. Played from the encoded AFM, the
 // nose's tip moves by value x FAPU (the MPEG-4 table and the FAPU, not the
@@ -3100,7 +3103,7 @@ std::vector<double> played_along(const afm_doc &doc, int group, int index, const
 TEST(FapSynthesis, AnUnderReachingSideMovesItsFdpByTheValueUpToItsReachAndHoldsThere) {
   const Built &b = head_1k();
   FaceModel m = b.model;
-  m.fapu.ens0 *= 8;
+  m.fapu.ens0 *= 16;
   FapSynthesisOptions o;
   constexpr int kFap = 64;
   const int R = find_fap_mapping(kFap)->reference;

@@ -1,14 +1,14 @@
 /* afm/render.h's renderer: loads the OSMesa context (libafm_osmesa.so,
  * osmesa_plugin.h says why) on the first afm_renderer_create and forwards to
  * it. A program that never draws never maps libOSMesa or libLLVM. */
-#define _GNU_SOURCE 1 /* readlink */
+#define _GNU_SOURCE 1 /* readlink and dlopen under -std=c99 */
 
 #include "afm/render.h"
 
 #include <dlfcn.h>
 #include <limits.h>
-#include <stdio.h>
 #include <pthread.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
