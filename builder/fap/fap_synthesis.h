@@ -91,13 +91,13 @@
 // gets one more solve, from that pose, that may pass the range with its
 // tensions extrapolated up to kMaxFapScale (and, still short there with the
 // skin a face, one more from there up to kFurtherFapScale), each within a
-// budget of Newton iterations (none where the skin already folds at s = 1, where the FDP
-// moves the wrong way at s = 1: the load control steers an action that grows
-// with the load, or where it moves less than a FAP unit); its pose is kept
-// if the skin stays a face as the target would store it, its slivers
-// untangled (untangle.h, with the FAP's FDP fixed; not where the turned
-// skin tears, SkinFaults::tears, nor at the lip corners, where streams add
-// the targets' slivers up to folds): face_model.h, skin_faults: no skin
+// budget of Newton iterations (none where the skin already folds at s = 1,
+// where the FDP moves the wrong way at s = 1: the load control steers an
+// action that grows with the load, or where it moves less than a FAP unit);
+// its pose is kept if the skin stays a face as the target would store it,
+// its slivers untangled (untangle.h, with the FAP's FDP fixed; not where
+// the turned skin tears, SkinFaults::tears, nor at the lip corners, where
+// streams add the targets' slivers up to folds): face_model.h, skin_faults: no skin
 // triangle turned over, nothing below the skull; on a simulation mesh,
 // none of the lifted skin's either (FapSynthesisOptions::sim). Where it
 // does not, a pose short of the fold that does (one more solve, to 3/4 of

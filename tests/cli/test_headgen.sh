@@ -28,7 +28,7 @@ ihdr=$(od -An -tx1 -j16 -N8 "$tmp/b.png" 2>/dev/null | tr -d ' \n')
 # The renderer (libOSMesa, which brings libLLVM) is a shared object loaded
 # for the first picture (ports/osmesa/src/osmesa_plugin.h). The loader's own
 # trace (LD_DEBUG=files lists every object it maps, dlopen'ed or not) shows
-# it mapped for the run above with a picture, and not for a run without one.
+# it mapped for a run with a picture, and not for a run without one.
 LD_DEBUG=files "$bin" --vertices 1000 -o "$tmp/p.wrl" --render "$tmp/p.png" --size 40x40 \
   >/dev/null 2>"$tmp/ld.txt" || fail "a run with a picture failed under LD_DEBUG"
 grep -q "file=libafm_osmesa.so\|file=.*/libafm_osmesa.so" "$tmp/ld.txt" ||

@@ -5,7 +5,7 @@
  *
  * Why a shared object: libOSMesa brings libLLVM, whose relocations cost a
  * program about 0.06 s at every start, pictures or not (afm-build without
- * --report, afm-headgen without --png). Loaded when a picture is asked for,
+ * --report, afm-headgen without --render). Loaded when a picture is asked for,
  * only the programs that draw pay it.
  *
  * The object exports one symbol, AFM_OSMESA_PLUGIN_ENTRY, a function that
