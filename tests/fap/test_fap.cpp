@@ -2882,8 +2882,9 @@ TEST(FapSynthesis, SongsMouthCornerComesInToItsReferenceWithoutAFold) {
 // reference in at four times the table's contraction (kMaxFapScale), the
 // skin still a face, and held it there. A group still short at that cap
 // goes on from there up to kFurtherFapScale: the wing comes in the whole
-// reference at 5.3 times, its motion 4 % off the FAP's direction, and folds
-// none of the lifted skin. One target, no hold.
+// reference, 0.09 units across it of 2.50 here (in the whole AFM's report at
+// 5.3 times, 3.8 % off-axis), and folds none of the lifted skin. One target,
+// no hold.
 TEST(FapSynthesis, SongsNoseWingNarrowsToItsReferencePastFourTimesItsRange) {
   AFM_REQUIRE_SHARED_DATA();
   EXPECT_EQ(expect_song_negative_side(61, {61}, 0.98), 1) << "the target at -100";
@@ -3094,7 +3095,8 @@ std::vector<double> played_along(const afm_doc &doc, int group, int index, const
 // taken 16 times longer, the nose's benders bend the tip (FAP 64) by a share
 // of its reference, either way (20 of 60), and reach no further at 8 times
 // their range (kFurtherFapScale; 8 times longer took them to 39 at 4, and to
-// the reference past it). (Until the benders came, nasalis did so at the head's own unit.)
+// the reference past it). (Until the benders came, nasalis did so at the
+// head's own unit.)
 // Each side's pose is then stored at the whole FAP units it reaches, and
 // held from there to the reference. Played from the encoded AFM, the
 // nose's tip moves by value x FAPU (the MPEG-4 table and the FAPU, not the
