@@ -394,11 +394,13 @@ int main(int argc, char **argv) {
   Expected<SimFaceModel> built = build_sim_face_model(face->scene, face->fdps, sm, fo, [&](const SimMesh &m) {
     if (!quiet && meshes++ > 0) end_progress();  // after the failed build's progress
     if (m.decimated)
-      std::printf("simulation mesh: %zu of the skin's %lld vertices, %lld triangles%s (%.2f s)\n", m.kept.size(),
+      std::printf("simulation mesh: %zu of the skin's %lld vertices, %lld triangles%s%s (%.2f s)\n", m.kept.size(),
                   static_cast<long long>(m.binding.corner.rows()), static_cast<long long>(m.F.rows()),
                   !m.mirrored         ? ""
                   : m.unpaired == 0 ? ", mirror-symmetric"
                                     : (", mirror-symmetric but for " + std::to_string(m.unpaired) + " collapses").c_str(),
+                  m.short_edges > 0 ? (", " + std::to_string(m.short_edges) + " of the shortest edges collapsed first").c_str()
+                                    : "",
                   m.seconds);
   });
   if (!quiet) end_progress();
