@@ -64,9 +64,9 @@ constexpr double kLidKeep = 0.1;
 constexpr double kMaxNormalTurnDegrees = 60;
 constexpr double kMaxDistance = 0.03;
 constexpr float kMaxAspectRatio = 5;
-// Before the lips are kept, every edge shorter than this share of the skin's
+// Before the lips are kept, every edge shorter than a share of the skin's
 // mean edge is collapsed where legal (FDP, muscle key and lid vertices stay),
-// each collapse allowed to turn a normal by up to kMicroNormalTurnDegrees.
+// each collapse allowed to turn a normal by up to this many degrees.
 // Song's mouth corners hold clusters of triangles a thousandth of its mean
 // triangle in area (its lips curl in where they meet); kept whole with the
 // lips, the solver turned them over at the table's contractions, and the
@@ -76,9 +76,9 @@ constexpr float kMaxAspectRatio = 5;
 // iterations. At 60 degrees the clusters stay (they sit on the crease where
 // the lips meet); at 0.3 of the mean edge the 2k head's brows fold sooner
 // (worst along 28 -> 56 %); at 0.15 the generated heads' meshes and AFMs are
-// the same (docs/notes.md, seventy-fifth session).
-constexpr double kMicroEdge = 0.15;
-constexpr double kMicroNormalTurnDegrees = 90;
+// the same (docs/notes.md, seventy-fifth session). The share is
+// SimMeshOptions::short_edge, kShortEdgeShare by default (sim_mesh.h).
+constexpr double kShortEdgeNormalTurnDegrees = 90;
 
 // Priority: the edge's squared length over the squared sizing at its
 // midpoint (shortest first). Not binary: it orders the collapses.
@@ -90,7 +90,7 @@ class ModSizedLengthT : public OpenMesh::Decimater::ModBaseT<MeshT> {
   explicit ModSizedLengthT(MeshT &mesh) : Base(mesh, false) {}
 
   std::function<double(const Eigen::Vector3d &)> sizing;
-  // Longer edges may not collapse (the first pass, kMicroEdge); model units.
+  // Longer edges may not collapse (the first pass, SimMeshOptions::short_edge); model units.
   double max_length = std::numeric_limits<double>::infinity();
   // A value in [0, 1) of the far end that breaks ties between collapses of
   // equal length (1e-4 of the priority: above a float's resolution), or none.
@@ -523,15 +523,16 @@ Expected<SimMesh> make_sim_mesh(const Scene &scene, const FdpSet &fdps, const Si
   dec.module(aspect).set_binary(true);
   if (!dec.initialize()) return identity();
   dec.set_order(&dec.module(length));
-  // The shortest edges first (kMicroEdge), then the lips kept and the rest.
+  // The shortest edges first (SimMeshOptions::short_edge), then the lips
+  // kept and the rest.
   double edges = 0;
   for (Eigen::Index f = 0; f < skin.F.rows(); ++f)
     for (int k = 0; k < 3; ++k) edges += (skin.V.row(skin.F(f, k)) - skin.V.row(skin.F(f, (k + 1) % 3))).norm();
   const double mean_edge = edges / std::max<double>(1, 3.0 * static_cast<double>(skin.F.rows()));
-  dec.module(length).max_length = kMicroEdge * mean_edge;
-  dec.module(normal).set_normal_deviation(kMicroNormalTurnDegrees);
+  dec.module(length).max_length = std::max(options.short_edge, 0.0) * mean_edge;
+  dec.module(normal).set_normal_deviation(kShortEdgeNormalTurnDegrees);
   size_t micro_unpaired = 0, unpaired = 0;
-  const size_t micro = dec.decimate_to(0, &micro_unpaired);
+  const size_t micro = options.short_edge > 0 ? dec.decimate_to(0, &micro_unpaired) : 0;
   dec.module(length).max_length = std::numeric_limits<double>::infinity();
   dec.module(normal).set_normal_deviation(kMaxNormalTurnDegrees);
   keep_lips(mesh, skin, lips, kLipKeep * es0, options.vertices / 2);

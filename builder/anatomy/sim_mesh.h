@@ -59,6 +59,8 @@ namespace afmb {
 
 // afm-build's default simulation mesh size.
 constexpr int kDefaultSimVertices = 1000;
+// The first pass's edges, in shares of the skin's mean edge (above).
+constexpr double kShortEdgeShare = 0.15;
 
 struct SimMeshOptions {
   // Coarse vertex count to aim at. 0, or a skin of at most 1.25 times as
@@ -68,6 +70,10 @@ struct SimMeshOptions {
   // Skin vertices to keep besides the FDPs' (with their mirror images on a
   // mirror-symmetric skin), e.g. muscle_key_vertices().
   std::vector<int> keep = {};  // (an initializer: SimMeshOptions{N} stays warning-free)
+  // The first pass collapses edges shorter than this share of the skin's
+  // mean edge; 0: no first pass (the meshes before the seventy-fifth
+  // session, for the tests whose case they hold).
+  double short_edge = kShortEdgeShare;
 };
 
 struct SimMesh {

@@ -316,7 +316,7 @@ bool solved_fap_target(const FapOutcome &o) {
 }
 
 bool solved_own_pose(const FapOutcome &o) {
-  return o.made && !o.holds && (o.kind != AFM_TARGET_FAP || solved_fap_target(o));
+  return o.made && !o.holds && !o.past_reference && (o.kind != AFM_TARGET_FAP || solved_fap_target(o));
 }
 
 Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &model, const FapSynthesisOptions &options) {
@@ -1620,7 +1620,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
   // own (on workers: a serial 0.2 s of Song's AFM); they join `out` in the
   // work list's order.
   struct Finished {
-    std::optional<std::pair<MorphTarget, FapOutcome>> reach, far;  // before and after the target
+    std::optional<std::pair<MorphTarget, FapOutcome>> reach, far, past;  // before and after the target
   };
   std::vector<Finished> finished(results.size());
   for_each_task(results.size(), options.threads, [&](size_t k) {
@@ -1649,6 +1649,59 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       finished[k].far = lip_past_reach(k, t, r.outcome, hold);
     }
   });
+  // Held past the reference (fap_synthesis.h): a lip corner's side whose
+  // target, summed with its partners' at the same value (the FAPs that move
+  // its FDP the same way) and taken kCornerStreamReach times as far, turns
+  // the skin over. Judged once every target is untangled.
+  const size_t sk = static_cast<size_t>(model.skin);
+  for (size_t k = 0; k < results.size(); ++k) {
+    const FapMapping *f = work[k].fap;
+    const Result &r = results[k];
+    if (!options.hold_past_reference || !f || f->driver != FapDriver::Muscles || work[k].in_between ||
+        !r.target || !r.outcome.made || finished[k].reach)
+      continue;
+    const afm_fap_info *info = afm_fap(f->fap);
+    const int v = fdp_vertex(model, info);
+    const Eigen::MatrixXd &D = r.target->displacement[sk];
+    if (!lip_corner_fdp(info) || v < 0 || D.rows() != skin.n) continue;
+    const Eigen::Vector3d dir = fap_direction(info);
+    Eigen::MatrixXd sum = D;
+    std::string with;
+    for (size_t j = 0; j < results.size(); ++j) {
+      const FapMapping *g = work[j].fap;
+      if (j == k || !g || g->fap == f->fap || work[j].side != work[k].side || work[j].in_between ||
+          !results[j].target || !results[j].outcome.made)
+        continue;
+      const afm_fap_info *gi = afm_fap(g->fap);
+      const Eigen::MatrixXd &Dj = results[j].target->displacement[sk];
+      if (fdp_vertex(model, gi) != v || fap_direction(gi) != dir || Dj.rows() != skin.n) continue;
+      sum += static_cast<double>(work[k].reference) / work[j].reference * Dj;
+      with += (with.empty() ? "" : ", ") + std::to_string(g->fap);
+    }
+    const SkinFaults folds = face_faults(rest + kCornerStreamReach * sum);
+    if (folds.turned_faces.empty() && folds.lifted_turned_faces.empty()) continue;
+    const int past = static_cast<int>(std::lround(kCornerStreamReach * work[k].reference));
+    std::pair<MorphTarget, FapOutcome> past_hold{*r.target, r.outcome};
+    MorphTarget &ht = past_hold.first;
+    FapOutcome &ho = past_hold.second;
+    ht.reference = work[k].side * past;
+    ho.reference = ht.reference;
+    ho.in_between = ho.past_reference = true;
+    ho.holds = ho.at_reach = false;
+    ho.seconds = 0;
+    ho.prescribed = r.outcome.prescribed * (static_cast<double>(past) / work[k].reference);
+    measure(ho, r.outcome.achieved, dir);
+    ho.reached = r.outcome.reached * work[k].reference / past;
+    char what[240];
+    std::snprintf(what, sizeof what,
+                  "holds the pose of %d past it: %s%s%s taken %.2g times as far turns %zu skin triangles over "
+                  "(%zu of the input's)",
+                  work[k].side * work[k].reference, with.empty() ? "" : "with FAP ", with.c_str(),
+                  with.empty() ? "it" : "'s at the same value,", kCornerStreamReach, folds.turned_faces.size(),
+                  folds.lifted_turned_faces.size());
+    ho.message = what;
+    finished[k].past = std::move(past_hold);
+  }
   for (size_t k = 0; k < results.size(); ++k) {
     Result &r = results[k];
     Finished &f = finished[k];
@@ -1662,6 +1715,10 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     if (f.far) {
       out.targets.push_back(std::move(f.far->first));
       out.outcomes.push_back(std::move(f.far->second));
+    }
+    if (f.past) {
+      out.targets.push_back(std::move(f.past->first));
+      out.outcomes.push_back(std::move(f.past->second));
     }
   }
   // The jaw's controls bend at FAP 3's in-betweens, so the teeth are where

@@ -126,6 +126,20 @@
 // FapSynthesisOptions::hold_reach = false stores the pose once, at the
 // table's reference.
 //
+// Held past the reference. A lip corner's FAPs move one FDP between them
+// (the inner and outer lip's: each moves it by a share), and streams send
+// them together, up to kCornerStreamReach times their reference (Xface's
+// joy.fap stretches the corners to 110 of 70). Where such a side's target
+// and its partners' at the same value, summed and taken that far, turn the
+// skin over (the input's too, as the player shows it), the side's target is
+// also stored as an in-between at that value (FapOutcome::past_reference):
+// past its reference the corner holds the reference's pose instead of
+// going on, and the sum at the reference is the most the streams show.
+// Song's corners stretched (6, 7, 53, 54), which reach their reference
+// past the table's contractions: extrapolated, joy.fap and anger.fap turned
+// 2-4 triangles of the cheek in 12-13 frames each. Not for a side that
+// holds its reach already.
+//
 // Second groups (FapMapping::second_positive, _negative). A side whose own
 // group falls short of the reference is made again with its second group,
 // in the same task right after (mirror twins as above: a right side's
@@ -176,6 +190,9 @@ namespace afmb {
 // 80 % of the reference at 4, all of it at 5.3).
 constexpr double kMaxFapScale = 4;
 constexpr double kFurtherFapScale = 8;
+// How far past their reference streams send the lip corners' FAPs, in
+// references: the in-between that holds them ("Held past the reference").
+constexpr double kCornerStreamReach = 1.6;
 
 struct FapOutcome {
   afm_target_kind kind = AFM_TARGET_FAP;
@@ -183,12 +200,15 @@ struct FapOutcome {
   int side = +1;                  // +1: the positive reference, -1: the negative one
   int reference = 0;              // signed FAP units (63 for visemes and expressions)
   bool in_between = false;        // one of FapMapping::farther (made only where reached in full),
-                                  // a hold, or a lower lip side past its reach (jaw_lips.h)
+                                  // a hold, a lower lip side past its reach (jaw_lips.h), or
+                                  // a lip corner held past its reference
   bool holds = false;             // an in-between at the table's reference holding an
                                   // under-reaching side's pose ("Reach, then hold")
   bool at_reach = false;          // that side's target at the FAP units it reaches
   bool from_jaw = false;          // a lower lip side's in-between past its reach, made from
                                   // FAP 3's target (jaw_lips.h), not solved
+  bool past_reference = false;    // an in-between past the table's reference holding a lip
+                                  // corner's pose there ("Held past the reference")
   bool made = false;              // a target was made
   std::string message;            // why not, when !made; how far it reaches when it under-reaches
   double reached = 1;             // the achieved share of the prescribed motion along the
@@ -247,6 +267,9 @@ struct FapSynthesisOptions {
   // it to the table's reference ("Reach, then hold"); false: once, at the
   // table's reference.
   bool hold_reach = true;
+  // false: no lip corner is held past its reference ("Held past the
+  // reference"), for tests of what the targets alone are.
+  bool hold_past_reference = true;
   // Make a side its own group leaves short again with its second group
   // (FapMapping::second_positive, _negative) and keep the nearer ("Second
   // groups"); false: the own groups alone.

@@ -7,7 +7,7 @@
 namespace afmtest {
 
 SongOnSimMesh song_on_sim_mesh(const std::vector<std::string> &muscles, bool jaw, int vertices,
-                               const afmb::TissueParams &tissue) {
+                               const afmb::TissueParams &tissue, double short_edge) {
   SongOnSimMesh out;
   afmb::Expected<afmb::LoadedFace> f = afmb::load_face(
       shared_data("faces/song/song.WRL"), shared_data("faces/song/song.fdp"), afmb::LoadOptions{}, nullptr);
@@ -19,8 +19,9 @@ SongOnSimMesh song_on_sim_mesh(const std::vector<std::string> &muscles, bool jaw
   fo.calibrate_only = muscles;
   fo.calibrate_muscles = !muscles.empty();
   fo.calibrate_jaw = jaw;
-  afmb::Expected<afmb::SimFaceModel> m =
-      afmb::build_sim_face_model(out.face.scene, out.face.fdps, afmb::SimMeshOptions{vertices}, fo);
+  afmb::SimMeshOptions so{vertices};
+  so.short_edge = short_edge;
+  afmb::Expected<afmb::SimFaceModel> m = afmb::build_sim_face_model(out.face.scene, out.face.fdps, so, fo);
   EXPECT_TRUE(m.is_ok()) << m.status().message();
   if (m.is_ok()) out.built = std::move(*m);
   return out;

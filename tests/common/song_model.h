@@ -11,9 +11,10 @@
 
 namespace afmtest {
 
-// Song on a simulation mesh of `vertices` (afm-build's default), of
-// `tissue`, with only `muscles` calibrated (none when empty) and the jaw
-// when `jaw`; the loaded face (its whole skin) beside it.
+// Song on a simulation mesh of `vertices` (afm-build's default) whose first
+// pass collapses edges under `short_edge` of the skin's mean
+// (SimMeshOptions), of `tissue`, with only `muscles` calibrated (none when
+// empty) and the jaw when `jaw`; the loaded face (its whole skin) beside it.
 struct SongOnSimMesh {
   afmb::LoadedFace face;
   afmb::SimFaceModel built;
@@ -22,6 +23,7 @@ struct SongOnSimMesh {
 // Records a test failure (and leaves `built` empty) when Song does not load
 // or build.
 SongOnSimMesh song_on_sim_mesh(const std::vector<std::string> &muscles, bool jaw = false,
-                               int vertices = afmb::kDefaultSimVertices, const afmb::TissueParams &tissue = {});
+                               int vertices = afmb::kDefaultSimVertices, const afmb::TissueParams &tissue = {},
+                               double short_edge = afmb::kShortEdgeShare);
 
 }  // namespace afmtest

@@ -2355,6 +2355,7 @@ TEST(FapSynthesis, FapsSharingAMuscleSplitTheSkinBetweenTheirFdps) {
   FapSynthesisOptions o;
   o.negative_sides = false;
   o.steer = false;  // the group alone: its pose moves both FDPs
+  o.hold_past_reference = false;  // 59 alone, taken 1.6 times as far, folds this skin
   o.only = {12, 59};
   Expected<FapSynthesis> both = synthesize_faps(b.head.scene, m, o);
   o.only = {12};
@@ -2645,7 +2646,7 @@ LiftedSide negative_side_lifted(const SimFaceModel &sm, FapSynthesisOptions o, c
   size_t next = 0;
   for (const FapOutcome &out : syn->outcomes) {
     if (!out.made) continue;
-    if (out.side < 0 && !out.from_jaw) m = {out, syn->targets[next]};
+    if (out.side < 0 && !out.from_jaw && !out.past_reference) m = {out, syn->targets[next]};
     ++next;
   }
   EXPECT_TRUE(m.outcome.made) << "the negative side is not made";
@@ -2682,13 +2683,16 @@ int expect_only_the_lifted_skin_folds(const SongOnSimMesh &song, const LiftedSid
 // does of a coarse one (fap_synthesis.h). (Until the lips got drivers of
 // their own, FAP 16's negative side, pursing by orbicularis oris, showed it.)
 // On the tissue before the layered skin and the floor (unlayered_tissue):
-// on the default one the corners drawn in fold neither skin.
+// on the default one the corners drawn in fold neither skin. And on a
+// simulation mesh without its first pass (SimMeshOptions::short_edge 0):
+// with the corners' clusters of tiny triangles collapsed, neither skin
+// folds.
 TEST(FapSynthesis, ATargetMadeOnASimulationMeshDoesNotFoldTheLiftedSkin) {
   AFM_REQUIRE_SHARED_DATA();
   // On an 800-vertex mesh: on afm-build's 1,000, decimated in mirror pairs
   // since the thirty-fourth session, none of Song's mouth FAPs folds the
   // lifted skin and not the coarse one.
-  const SongOnSimMesh song = song_on_sim_mesh({"orbicularis_oris"}, false, 800, unlayered_tissue());
+  const SongOnSimMesh song = song_on_sim_mesh({"orbicularis_oris"}, false, 800, unlayered_tissue(), 0);
   ASSERT_FALSE(HasFailure());
   ASSERT_TRUE(song.built.sim.decimated);
   FapSynthesisOptions o;
@@ -2715,13 +2719,15 @@ TEST(FapSynthesis, ATargetMadeOnASimulationMeshDoesNotFoldTheLiftedSkin) {
 // reference as it does blind to the lifted skin, and the skin it stores
 // turns none. Judged by the raw slivers, it stopped at 88 % (fifty-ninth
 // session). On the tissue before the layered skin and the floor
-// (unlayered_tissue): on the default one the lifted skin stays whole.
+// (unlayered_tissue): on the default one the lifted skin stays whole; and
+// on a simulation mesh without its first pass (SimMeshOptions::short_edge
+// 0): on today's, it stays whole too.
 TEST(FapSynthesis, ALiftedSliverTheUntanglingStraightensDoesNotStopASide) {
   AFM_REQUIRE_SHARED_DATA();
   FapSynthesisOptions o;
   o.only = {52};
   const SongOnSimMesh song = song_on_sim_mesh(calibration_needs(o).muscles, false, kDefaultSimVertices,
-                                              unlayered_tissue());
+                                              unlayered_tissue(), 0);
   ASSERT_FALSE(HasFailure());
   ASSERT_TRUE(song.built.sim.decimated);
   const LiftedSide blind = negative_side_lifted(song.built, o, nullptr),
@@ -2742,15 +2748,16 @@ TEST(FapSynthesis, ALiftedSliverTheUntanglingStraightensDoesNotStopASide) {
 // the whole AFM does (made alone, a FAP keeps the skin its neighbours share
 // there, and folds differently). FAP `fap`'s solved targets fold none of
 // the lifted skin (an independent count) and sink nothing; each of its
-// negative side's (the target at its reach and the hold, or the target at
-// the reference) takes the FDP against the FAP's direction by at least
-// `least` of the MPEG-4 rule, reference x FAPU, and across the face (in the
-// face's plane, square to the direction) by less than `across` of that.
+// `side`'s (the target at its reach and the hold, or the target at the
+// reference) takes the FDP along the FAP's direction times `side` by at
+// least `least` of the MPEG-4 rule, reference x FAPU, and across the face
+// (in the face's plane, square to the direction) by less than `across` of
+// that.
 // Where another FAP moves the same FDP (`partner`: the outer lip's corner
 // FAP for the inner one's), each target's motion is its and the partner's
 // target's at the same value together, as streams send them and the report
-// measures them. Returns the number of negative-side targets checked.
-int expect_song_negative_side(int fap, std::vector<int> only, double least, double across = 0.15, int partner = 0) {
+// measures them. Returns the number of `side` targets checked.
+int expect_song_side(int side, int fap, std::vector<int> only, double least, double across = 0.15, int partner = 0) {
   FapSynthesisOptions o;
   o.only = std::move(only);
   SongOnSimMesh song = song_on_sim_mesh(calibration_needs(o).muscles);
@@ -2777,7 +2784,7 @@ int expect_song_negative_side(int fap, std::vector<int> only, double least, doub
     motion.push_back(&syn->targets[motion.size()].displacement[static_cast<size_t>(sm.sim.skin)]);
     if (out.number == partner) partner_at[{out.reference, out.holds}] = motion.back();
   }
-  int negative = 0;
+  int checked = 0;
   size_t next = 0;
   for (const FapOutcome &out : syn->outcomes) {
     if (!out.made) continue;
@@ -2794,12 +2801,12 @@ int expect_song_negative_side(int fap, std::vector<int> only, double least, doub
     }
     EXPECT_EQ(turned_over(part.V, part.F, part.V + D), 0) << "FAP " << fap << " at " << out.reference;
     EXPECT_EQ(out.sunk, 0) << "FAP " << fap << " at " << out.reference;
-    if (out.side > 0) continue;
-    ++negative;
-    // Against the direction, as far as the target says, and not across it.
+    if (out.side != side) continue;
+    ++checked;
+    // Along the side's direction, as far as the target says, and not across it.
     const Eigen::Vector3d d = D.row(fdp->vertex).transpose();
-    const double along = -d.dot(dir);
-    Eigen::Vector3d off = d + along * dir;
+    const double along = side * d.dot(dir);
+    Eigen::Vector3d off = d - side * along * dir;
     off.z() = 0;  // depth apart: the lips come forward as they move
     std::printf("FAP %d at %d: %s %.2f units of %.2f (%.0f %%), across %.2f, forward %.2f (%s)\n", fap,
                 out.reference, FdpId{info->fdp_group, info->fdp_index}.str().c_str(), along, value,
@@ -2810,7 +2817,7 @@ int expect_song_negative_side(int fap, std::vector<int> only, double least, doub
       EXPECT_NEAR(out.reached, along / value, 0.01) << "FAP " << fap;
     }
   }
-  return negative;
+  return checked;
 }
 
 // Song's inner brow lowered (FAP 31's negative side, which real streams
@@ -2824,7 +2831,7 @@ int expect_song_negative_side(int fap, std::vector<int> only, double least, doub
 // (docs/anatomy.md, "Depressor supercilii").
 TEST(FapSynthesis, SongsInnerBrowComesDownMostOfItsReferenceWithoutAFold) {
   AFM_REQUIRE_SHARED_DATA();
-  EXPECT_EQ(expect_song_negative_side(31, {31, 33, 35, 37}, 0.6), 2) << "the target at its reach and the hold at -200";
+  EXPECT_EQ(expect_song_side(-1, 31, {31, 33, 35, 37}, 0.6), 2) << "the target at its reach and the hold at -200";
 }
 
 // Song's lower lip lowered at its left middle (FAP 57's negative side, which
@@ -2839,7 +2846,7 @@ TEST(FapSynthesis, SongsInnerBrowComesDownMostOfItsReferenceWithoutAFold) {
 // docs/anatomy.md, "Depressor labii inferioris").
 TEST(FapSynthesis, SongsLowerLipComesDownToItsReferenceWithoutAFold) {
   AFM_REQUIRE_SHARED_DATA();
-  EXPECT_EQ(expect_song_negative_side(57, {52, 57, 58}, 0.9), 1) << "the target at -350";
+  EXPECT_EQ(expect_song_side(-1, 57, {52, 57, 58}, 0.9), 1) << "the target at -350";
 }
 
 // Song's inner lower lip lowered at its middle (FAP 5's negative side, which
@@ -2850,7 +2857,7 @@ TEST(FapSynthesis, SongsLowerLipComesDownToItsReferenceWithoutAFold) {
 // comes down the whole reference, -350, and folds none of the lifted skin.
 TEST(FapSynthesis, SongsInnerLowerLipComesDownToItsReferenceWithoutAFold) {
   AFM_REQUIRE_SHARED_DATA();
-  EXPECT_EQ(expect_song_negative_side(5, {5, 10, 11, 52, 57, 58}, 0.9), 1) << "the target at -350";
+  EXPECT_EQ(expect_song_side(-1, 5, {5, 10, 11, 52, 57, 58}, 0.9), 1) << "the target at -350";
 }
 
 // Its left side lowered (FAP 10's negative side; streams send it to -870):
@@ -2861,20 +2868,39 @@ TEST(FapSynthesis, SongsInnerLowerLipComesDownToItsReferenceWithoutAFold) {
 // off it, and folds none of the lifted skin.
 TEST(FapSynthesis, SongsInnerLowerLipSideComesDownToItsReferenceWithoutAFold) {
   AFM_REQUIRE_SHARED_DATA();
-  EXPECT_EQ(expect_song_negative_side(10, {5, 10, 11, 52, 57, 58}, 0.95), 1) << "the target at -350";
+  EXPECT_EQ(expect_song_side(-1, 10, {5, 10, 11, 52, 57, 58}, 0.95), 1) << "the target at -350";
 }
 
 // Song's left mouth corner drawn in (FAP 6's negative side; Crystal's
 // streams send it to -80): orbicularis oris alone took 2.4 61 % of the
-// reference in and held it there, the skin folding past its range. Its
-// second group (fap_mapping.cpp) adds risorius driven backwards, a push
-// toward the mouth's middle, and zygomaticus major's, less: the corner
-// comes in the whole reference, lower by a quarter of that (the lips come
-// forward too, which the check leaves apart), and folds none of the lifted
-// skin.
+// reference in and held it there, the skin folding past its range; its
+// second group (fap_mapping.cpp) added risorius driven backwards, a push
+// toward the mouth's middle, and zygomaticus major's, less, and the corner
+// came in the whole reference, lower by a quarter of that. Since the
+// simulation mesh collapses the skin's shortest edges first (sim_mesh.h),
+// orbicularis oris, steered, takes it in the whole reference, 0.06 units
+// across it of 1.74 here, and folds none of the lifted skin. With FAP 53's,
+// 1.6 times as far turns a triangle: the side is held past its reference
+// (fap_synthesis.h), the same pose at -112.
 TEST(FapSynthesis, SongsMouthCornerComesInToItsReferenceWithoutAFold) {
   AFM_REQUIRE_SHARED_DATA();
-  EXPECT_EQ(expect_song_negative_side(6, {6, 53}, 0.95, 0.3, 53), 1) << "the target at -70, with FAP 53's";
+  EXPECT_EQ(expect_song_side(-1, 6, {6, 53}, 0.95, 0.3, 53), 2) << "the target at -70 and its hold at -112, with FAP 53's";
+}
+
+// Song's left mouth corner stretched (FAP 6's positive side, with FAP 53's:
+// streams send them to 110): risorius took 2.4 71 % of the reference out and
+// held it there, the skin folding already at the table's contraction: tiny
+// triangles of the mouth corner's cluster (a thousandth of the mean in area)
+// turned over. The simulation mesh now collapses the skin's shortest edges
+// first (sim_mesh.h), and the corner goes out the whole reference past the
+// table's contraction, 0.34 units across it of 1.74 here (and 0.87 back,
+// into the cheek, which the check leaves apart), folding none of the lifted
+// skin. With FAP 53's, 1.6 times as far turns triangles of the cheek (as
+// joy.fap did, 12 of its frames): the side is held past its reference, the
+// same pose at 112 (fap_synthesis.h).
+TEST(FapSynthesis, SongsMouthCornerStretchesToItsReferenceWithoutAFold) {
+  AFM_REQUIRE_SHARED_DATA();
+  EXPECT_EQ(expect_song_side(+1, 6, {6, 53}, 0.95, 0.25, 53), 2) << "the target at 70 and its hold at 112, with FAP 53's";
 }
 
 // Song's left nose wing narrowed (FAP 61's negative side): the wing's
@@ -2887,7 +2913,7 @@ TEST(FapSynthesis, SongsMouthCornerComesInToItsReferenceWithoutAFold) {
 // no hold.
 TEST(FapSynthesis, SongsNoseWingNarrowsToItsReferencePastFourTimesItsRange) {
   AFM_REQUIRE_SHARED_DATA();
-  EXPECT_EQ(expect_song_negative_side(61, {61}, 0.98), 1) << "the target at -100";
+  EXPECT_EQ(expect_song_side(-1, 61, {61}, 0.98), 1) << "the target at -100";
 }
 
 // Song's jaw, opened as FAP 3 says, on afm-build's simulation mesh: the
