@@ -106,7 +106,7 @@ WholeAfm whole_afm(const Scene &scene, const FdpSet &fdps, const FaceModelOption
     return w;
   }
   for (const FapOutcome &o : st->outcomes) {
-    w.under += o.made && o.reached < 1;
+    w.under += o.made && o.reached < 1 && !o.past_reference;  // held past: its side reaches
     if (solved_own_pose(o)) w.slabs += o.slabs;
   }
   w.made = st->targets.size(), w.tried = st->outcomes.size();

@@ -312,11 +312,11 @@ CalibrationNeeds calibration_needs(const FapSynthesisOptions &options) {
 }
 
 bool solved_fap_target(const FapOutcome &o) {
-  return o.made && o.kind == AFM_TARGET_FAP && !kinematic_fap(o.number) && !o.from_jaw;
+  return o.made && o.kind == AFM_TARGET_FAP && !kinematic_fap(o.number) && !o.from_jaw && !o.past_reference;
 }
 
 bool solved_own_pose(const FapOutcome &o) {
-  return o.made && !o.holds && !o.past_reference && (o.kind != AFM_TARGET_FAP || solved_fap_target(o));
+  return o.made && !o.holds && (o.kind != AFM_TARGET_FAP || solved_fap_target(o));
 }
 
 Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &model, const FapSynthesisOptions &options) {

@@ -244,8 +244,9 @@ struct FapOutcome {
 // Whether a made outcome is a FAP target the face model solved (muscles,
 // jaw, lids): the ones the fidelity figures summarise. The tongue's and the
 // pupils' (kinematic_fap) and the lower lip's in-betweens past its reach
-// (from_jaw) are exact by construction, and visemes and expressions have no
-// FDP rule.
+// (from_jaw) are exact by construction, a lip corner held past its
+// reference (past_reference) stores its reference's pose, and visemes and
+// expressions have no FDP rule.
 bool solved_fap_target(const FapOutcome &o);
 
 // Whether a made outcome's pose is its own solve, counted once where a

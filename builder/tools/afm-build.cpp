@@ -61,7 +61,8 @@ void usage(FILE *out) {
       "  --sim-vertices N|full   simulate on a coarser copy of the skin of about N\n"
       "                          vertices (its own, every skin FDP among them; finer\n"
       "                          around eyes and mouth; mirror-symmetric where the\n"
-      "                          skin is) and carry the motion to every\n"
+      "                          skin is; the skin's shortest edges, under %g of its\n"
+      "                          mean, collapsed first) and carry the motion to every\n"
       "                          skin vertex (default %d; full: the skin itself, as is\n"
       "                          any skin of at most 1.25 N vertices). The\n"
       "                          pictures of the model show the simulation mesh. A\n"
@@ -108,8 +109,12 @@ void usage(FILE *out) {
       "                          motion kept; else the target\n"
       "                          under-reaches, and says so: its pose is then stored at\n"
       "                          the FAP units it reaches and held from there to the\n"
-      "                          reference, as an in-between; a viseme or expression\n"
-      "                          whose table pose tears the skin is made with the largest\n"
+      "                          reference, as an in-between; a lip corner's side whose\n"
+      "                          target, with its partners' (the inner and outer lip's)\n"
+      "                          taken %g times as far, folds the skin is held past its\n"
+      "                          reference (an in-between there with the same pose);\n"
+      "                          a viseme or expression whose table pose tears the skin\n"
+      "                          is made with the largest\n"
       "                          share of the muscles to blame that does not, and says so)\n"
       "  --profile P             draco (default: compressed) or raw\n"
       "  --faps LIST             only these targets: FAP numbers, vN visemes, eN\n"
@@ -151,8 +156,8 @@ void usage(FILE *out) {
       "\n"
       "Exit status: 0 on success (FAPs that cannot be made are reported, not fatal), 1\n"
       "on bad input, an output that cannot be written or a solve that does not\n"
-      "converge (the message says which and why), 2 on bad usage.\n", kCollapseFloor, kDefaultSimVertices, kMaxFapScale,
-      kFurtherFapScale);
+      "converge (the message says which and why), 2 on bad usage.\n", kCollapseFloor, kShortEdgeShare, kDefaultSimVertices,
+      kMaxFapScale, kFurtherFapScale, kCornerStreamReach);
 }
 
 bool stderr_is_terminal() {
