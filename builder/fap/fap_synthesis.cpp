@@ -1692,12 +1692,12 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     ho.prescribed = r.outcome.prescribed * (static_cast<double>(past) / work[k].reference);
     measure(ho, r.outcome.achieved, dir);
     ho.reached = r.outcome.reached * work[k].reference / past;
-    char what[240];
+    const std::string whose = with.empty() ? "its target" : "with FAP " + with + "'s at the same value, its target";
+    char what[288];
     std::snprintf(what, sizeof what,
-                  "holds the pose of %d past it: %s%s%s taken %.2g times as far turns %zu skin triangles over "
+                  "holds the pose of %d past it: %s, taken %.2g times as far, turns %zu skin triangles over "
                   "(%zu of the input's)",
-                  work[k].side * work[k].reference, with.empty() ? "" : "with FAP ", with.c_str(),
-                  with.empty() ? "it" : "'s at the same value,", kCornerStreamReach, folds.turned_faces.size(),
+                  work[k].side * work[k].reference, whose.c_str(), kCornerStreamReach, folds.turned_faces.size(),
                   folds.lifted_turned_faces.size());
     ho.message = what;
     finished[k].past = std::move(past_hold);
