@@ -1662,6 +1662,9 @@ TEST(FapSynthesis, TheChinRaiserTakesTheChinBossToItsReference) {
 // that took the 1k head's inner brow 49 % of the way (Song's 52 %, the 10k
 // head's 40 %); with the push as far as the pull, the tissue is what stops
 // it: the 1k head 73 %, Song and the 10k head all of it (muscle_table.cpp).
+// Past its range the search stops short of where the skin folds: one solve
+// to 3/4 of the chord's unfolded share took the 1k head 87 % of the way; the
+// two that then halve the gap to the fold (kFoldBisections) 94 %.
 TEST(FapSynthesis, TheCorrugatorsPushSpreadsTheBrowsAsFarAsTheTissueLets) {
   const Built &b = head_1k();
   FapSynthesisOptions o;
@@ -1675,7 +1678,7 @@ TEST(FapSynthesis, TheCorrugatorsPushSpreadsTheBrowsAsFarAsTheTissueLets) {
   ASSERT_NE(apart, nullptr) << "no target for FAP 37's negative side";
   std::printf("FAP 37 at %d: %.0f %% of the prescribed motion, %.1f %% off the direction\n", apart->reference,
               100 * apart->reached, 100 * apart->off_axis);
-  EXPECT_GT(apart->reached, 0.65) << apart->message;
+  EXPECT_GT(apart->reached, 0.9) << apart->message;
 }
 
 // The nose's tip (9.3) goes where FAPs 63 (raised) and 64 (bent to the
