@@ -41,9 +41,9 @@ constexpr double kChordShare = 0.75;
 // solves that halve the gap between it and the fold, each from the last
 // pose that stays a face (seventy-fifth session: the 2k head's brows
 // squeezed 82 -> 95 % of their reference, drawn apart 72 -> 80 %; the 10k
-// head's outer lower lip raised 75 -> 87 %; Song's middle brow lowered 97 ->
-// 99 %; Newton iterations after the model +1.2 % on Song, +2.7 % and +12 %
-// on the 2k and 10k heads).
+// head's outer lower lip raised 75 -> 87 %, its lower lids lowered 74 -> 86 %;
+// Song's middle brow lowered 97 -> 99 %; Newton iterations after the model
+// +1.2 % on Song, +2.7 % and +12 % on the 2k and 10k heads).
 constexpr int kFoldBisections = 2;
 // Bisection steps on the share of a viseme's or expression's pose that
 // keeps the skin a face: to a sixteenth.
