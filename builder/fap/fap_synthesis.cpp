@@ -1408,6 +1408,9 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
   }
   // FAP targets that move the same skin split it (fap_partition.h).
   std::vector<Eigen::VectorXd> skin_share(work.size());  // per target: its share, empty when whole
+  // Per target: the other FAPs' targets that move its FDP the same way, on
+  // the same side (the lip corners': the inner and outer lip's).
+  std::vector<std::vector<size_t>> fdp_partners(work.size());
   {
     std::vector<SharingTarget> sharing(work.size());
     for (size_t k = 0; k < work.size(); ++k) {
@@ -1476,6 +1479,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
             sharing[j].direction != sharing[k].direction ||
             part.weight[j].size() == 0)
           continue;
+        fdp_partners[k].push_back(j);
         achieved += static_cast<double>(work[k].reference) / work[j].reference *
                     results[j].target->displacement[sk].row(v).transpose();
         with += (with.empty() ? "" : ", ") + std::to_string(sharing[j].fap);
@@ -1682,22 +1686,15 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
         !r.target || !r.outcome.made || finished[k].reach)
       continue;
     const afm_fap_info *info = afm_fap(f->fap);
-    const int v = fdp_vertex(model, info);
     const Eigen::MatrixXd &D = r.target->displacement[sk];
-    if (!lip_corner_fdp(info) || v < 0 || D.rows() != skin.n) continue;
+    if (!lip_corner_fdp(info) || D.rows() != skin.n) continue;
     const Eigen::Vector3d dir = fap_direction(info);
     Eigen::MatrixXd sum = D;
     std::string with;
-    for (size_t j = 0; j < results.size(); ++j) {
-      const FapMapping *g = work[j].fap;
-      if (j == k || !g || g->fap == f->fap || work[j].side != work[k].side || work[j].in_between ||
-          !results[j].target || !results[j].outcome.made)
-        continue;
-      const afm_fap_info *gi = afm_fap(g->fap);
-      const Eigen::MatrixXd &Dj = results[j].target->displacement[sk];
-      if (fdp_vertex(model, gi) != v || fap_direction(gi) != dir || Dj.rows() != skin.n) continue;
-      sum += static_cast<double>(work[k].reference) / work[j].reference * Dj;
-      with += (with.empty() ? "" : ", ") + std::to_string(g->fap);
+    for (size_t j : fdp_partners[k]) {
+      sum += static_cast<double>(work[k].reference) / work[j].reference *
+             results[j].target->displacement[sk];
+      with += (with.empty() ? "" : ", ") + std::to_string(work[j].fap->fap);
     }
     const SkinFaults folds = face_faults(rest + kCornerStreamReach * sum);
     if (folds.turned_faces.empty() && folds.lifted_turned_faces.empty()) continue;
