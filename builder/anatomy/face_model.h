@@ -259,6 +259,11 @@ struct SkinFaults {
     return !sunk_vertices.empty() || turned_share > kTornShare || stretched_share > kTornShare ||
            lifted_turned_share > kTornShare;
   }
+  // What no untangling mends (untangle.h), whatever turns over: vertices
+  // sunk into the skull, or triangles stretched beyond kTearStretch over
+  // more than kTornShare of the skin. How a FAP's pose is judged
+  // (fap_synthesis.cpp, target_faults).
+  bool breaks() const { return !sunk_vertices.empty() || stretched_share > kTornShare; }
 };
 SkinFaults skin_faults(const FaceModel &model, const Eigen::MatrixXd &E);
 

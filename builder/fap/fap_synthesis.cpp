@@ -363,14 +363,20 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
   // reached the reference (65 % before), and joy.fap, which sends them to
   // 1.6 times it with the corners raised, turned up to 3 triangles at them
   // in 31 of its 108 frames, none of the targets alone. Nor where the skin
-  // tears (SkinFaults::tears): that is no sliver.
+  // sinks into the skull or stretches past a tear (SkinFaults::breaks):
+  // that is no fold. Whole triangles turned are untangled too, however
+  // much of the skin they cover: judged torn past kTornShare (as visemes
+  // and expressions are, SkinFaults::tears), 1-6 triangles of the 2k head's
+  // skin near the brow buckling stopped its brows drawn apart at 80 % of the
+  // reference, and 2-21 below the 10k head's lower lip its outer lower lip
+  // lowered at 64 %; poses further on, steered, turn none and reach it.
   std::vector<char> corner(static_cast<size_t>(skin.n), 0);
   for (int fap = 3; fap <= AFM_FAP_COUNT; ++fap)
     if (const afm_fap_info *info = afm_fap(fap); info && lip_corner_fdp(info))
       if (const int v = fdp_vertex(model, info); v >= 0) corner[static_cast<size_t>(v)] = 1;
   auto target_faults = [&](const Eigen::MatrixXd &E, int fdp) {
     SkinFaults f = face_faults(E);
-    if ((f.turned_faces.empty() && f.lifted_turned_faces.empty()) || f.tears() ||
+    if ((f.turned_faces.empty() && f.lifted_turned_faces.empty()) || f.breaks() ||
         (fdp >= 0 && corner[static_cast<size_t>(fdp)]))
       return f;
     Eigen::MatrixXd D = E - rest;

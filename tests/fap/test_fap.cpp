@@ -1664,7 +1664,11 @@ TEST(FapSynthesis, TheChinRaiserTakesTheChinBossToItsReference) {
 // it: the 1k head 73 %, Song and the 10k head all of it (muscle_table.cpp).
 // Past its range the search stops short of where the skin folds: one solve
 // to 3/4 of the chord's unfolded share took the 1k head 87 % of the way; the
-// two that then halve the gap to the fold (kFoldBisections) 94 %.
+// two that then halve the gap to the fold (kFoldBisections) 94 %. The fold
+// there is a whole triangle beside the brow, buckled: judged as the target
+// would store it, untangled (SkinFaults::breaks instead of tears), the pose
+// past it is a face, and steered from there the brow reaches the reference
+// with none turned.
 TEST(FapSynthesis, TheCorrugatorsPushSpreadsTheBrowsAsFarAsTheTissueLets) {
   const Built &b = head_1k();
   FapSynthesisOptions o;
@@ -1678,7 +1682,8 @@ TEST(FapSynthesis, TheCorrugatorsPushSpreadsTheBrowsAsFarAsTheTissueLets) {
   ASSERT_NE(apart, nullptr) << "no target for FAP 37's negative side";
   std::printf("FAP 37 at %d: %.0f %% of the prescribed motion, %.1f %% off the direction\n", apart->reference,
               100 * apart->reached, 100 * apart->off_axis);
-  EXPECT_GT(apart->reached, 0.9) << apart->message;
+  EXPECT_EQ(apart->reached, 1) << apart->message;
+  EXPECT_EQ(apart->turned, 0) << apart->message;
 }
 
 // The nose's tip (9.3) goes where FAPs 63 (raised) and 64 (bent to the
@@ -1724,20 +1729,22 @@ TEST(FapSynthesis, TheNoseTipGoesUpDownAndSidewaysByItsReference) {
 // lips too (fap_mapping.cpp), and the side reaches its reference. On the
 // 2,000-vertex head, whose upper lip muscles cover 4 vertices, the muscles
 // alone took 2.2 38 % of the way; here the 1k head's FAP unit (MNS0) is
-// taken 4 times longer, so that its own group falls short as well (72 % at
-// eight times its range; 3 times longer, it reaches its reference alone
-// past four times, kFurtherFapScale; 5 times, the second group falls short).
+// taken 6.5 times longer, so that its own group falls short as well (94 %
+// at eight times its range; 6 times longer, 99 %; 7 times, the second group
+// falls short too). Four times longer, its own group fell short (72 %)
+// until the search judged its poses' buckled triangles untangled
+// (SkinFaults::breaks); since, it reaches the reference alone.
 TEST(FapSynthesis, TheUpperLipsMiddleRaisedReachesWithOrbicularisOrisParting) {
   const Built &b = head_1k();
   FaceModel m = b.model;
-  m.fapu.mns0 *= 4;
+  m.fapu.mns0 *= 6.5;
   FapSynthesisOptions o;
   o.only = {4};
   Expected<FapSynthesis> syn = synthesize_faps(b.head.scene, m, o);
   ASSERT_TRUE(syn.is_ok()) << syn.status().message();
   const FapOutcome *raised = made_at(*syn, 4, -find_fap_mapping(4)->reference);
   ASSERT_NE(raised, nullptr) << "no target for FAP 4's negative side";
-  std::printf("FAP 4 at %d, the 1k head's MNS0 4 times longer: %.0f %% of the prescribed motion, %.1f %% off "
+  std::printf("FAP 4 at %d, the 1k head's MNS0 6.5 times longer: %.0f %% of the prescribed motion, %.1f %% off "
               "the direction (%s)\n",
               raised->reference, 100 * raised->reached, 100 * raised->off_axis, raised->message.c_str());
   EXPECT_NE(raised->message.find("made with its second group"), std::string::npos) << raised->message;
