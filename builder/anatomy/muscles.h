@@ -35,9 +35,10 @@
 // radii of c. A vertex p at a turn alpha beyond a's (about the axis, growing
 // away from the opening; alpha_max the area's largest) weighs
 //   w = area(p) g(alpha) h(q),  g = 1 for alpha <= 0, (1 - alpha / alpha_max)^4 beyond,
-//                               h = cos(pi/2 q^2),
+//                               h = cos(pi/2 q^2) on an upper lid, cos(pi/2 q) on a lower one,
 // q = 0 over a and 1 at the eye's corner on p's side (and beyond): most at
-// the margin, nothing at the orbital rim and the corners. The load acts on
+// the margin, nothing at the orbital rim and the corners; a lower lid's
+// load gathers more in its middle (muscles.cpp says why). The load acts on
 // the vertex's epidermal, dermal and hypodermal nodes, a third each, except
 // nodes within half the eyeball's radius r of the axis. Its potential on a
 // node at rest distance rho0 from the axis is -t sense (w/3) (rho0^2 / r)

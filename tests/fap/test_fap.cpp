@@ -1165,6 +1165,41 @@ TEST(FapSynthesis, AnInBetweenTheLidDriverFallsShortOfIsMadeByTurningTheLid) {
   EXPECT_LE(deepest_in_eyeballs(s, R + blend), m.quantum) << "450, blended";
 }
 
+// The 10k head's lower lid lowered (FAP 21's negative side), on the
+// simulation mesh afm-build makes: to the table's reference, with no skin
+// triangle turned. Its driver's load, spread across the lid as the upper
+// one's (cos(pi/2 q^2)), came down near the inner corner almost as far as
+// in the middle and turned the triangle between the corner, the margin
+// and the skin below over: the lid stopped at 86 % of the reference, and
+// the driver found no equilibrium at +100 % (muscles.cpp).
+TEST(FapSynthesis, TheTenThousandVertexHeadsLowerLidComesDownByItsReference) {
+  RefHeadOptions ho;
+  ho.skin_vertices = 10000;
+  Expected<RefHead> head = make_reference_head(ho);
+  ASSERT_TRUE(head.is_ok()) << head.status().message();
+  FapSynthesisOptions o;
+  o.only = {21};
+  FaceModelOptions fo;
+  fo.calibrate_only = calibration_needs(o).muscles;
+  fo.calibrate_jaw = false;
+  Expected<SimFaceModel> b = build_sim_face_model(head->scene, head->fdps, {kDefaultSimVertices}, fo);
+  ASSERT_TRUE(b.is_ok()) << b.status().message();
+  const FaceModel &m = b->model;
+  const int lower = m.find("palpebral_lower_left");
+  ASSERT_GE(lower, 0);
+  EXPECT_EQ(m.muscles[static_cast<size_t>(lower)].range_max, 1) << "the driver reaches the table's range";
+  o.sim = &b->sim;
+  Expected<FapSynthesis> syn = synthesize_faps(b->scene, m, o);
+  ASSERT_TRUE(syn.is_ok()) << syn.status().message();
+  const FapOutcome *down = made_at(*syn, 21, -find_fap_mapping(21)->reference);
+  ASSERT_NE(down, nullptr) << "no target for FAP 21's negative side";
+  std::printf("FAP 21 at %d on the 10k head: %.0f %% of the prescribed motion, %.1f %% off the direction\n",
+              down->reference, 100 * down->reached, 100 * down->off_axis);
+  EXPECT_EQ(down->reached, 1) << down->message;
+  EXPECT_EQ(down->turned, 0) << down->message;
+  EXPECT_EQ(down->sunk, 0) << down->message;
+}
+
 // A group that moves its FDP less than a FAP unit at its calibrated range
 // makes no target, and nothing is tried past the range: FAP 64 (bend the
 // nose) on the 1k head with the FAP unit (ENS0) taken 400 times longer, so
