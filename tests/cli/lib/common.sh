@@ -8,6 +8,10 @@
 #                     temporary file is left in $tmp
 #   finish [NOTE]     prints the verdict and exits 0 or 1
 #   mask_fap3         prints a FAP stream's mask line sending FAP 3 (open_jaw) only
+#   fidelity_goals FILE NAME
+#                     afm-build's summary line in FILE meets the issue's fidelity
+#                     goals (along the FAP's direction median <= 3 %, worst
+#                     <= 10 %; off-axis median <= 15 %); prints the figures
 set -u
 : "${AFM_BUILD:=build}"
 bin="$AFM_BUILD/bin"
@@ -49,6 +53,20 @@ mask_fap3() {
     i=$((i + 1))
   done
   printf '\n'
+}
+
+fidelity_goals() {
+  line=$(grep '^targets: ' "$1")
+  [ -n "$line" ] || { fail "$2: no summary line: $(tail -n 3 "$1")"; return; }
+  echo "$line" | awk -v name="$2" '{
+      if (!match($0, /along the direction median [0-9.]+% worst [0-9.]+%; off-axis median [0-9.]+%/)) {
+        print "FAIL: " name ": no along and off-axis figures: " $0; exit 1 }
+      split(substr($0, RSTART, RLENGTH), w, /[ %;]+/)
+      median = w[5]; worst = w[7]; off = w[10]
+      printf "%s: along the direction median %s %%, worst %s %%; off-axis median %s %%\n", name, median, worst, off
+      if (median > 3 || worst > 10 || off > 15) {
+        print "FAIL: " name ": the goals are median <= 3 %, worst <= 10 %, off-axis median <= 15 %"; exit 1 }
+    }' || failures=$((failures + 1))
 }
 
 finish() {

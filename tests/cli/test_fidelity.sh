@@ -1,0 +1,27 @@
+#!/bin/sh
+# The issue's fidelity goals on the generated reference heads of 2,000 and
+# 10,000 skin vertices, every target made on the default simulation mesh:
+# each FAP side's error along its direction at the table's reference, median
+# at most 3 % and worst at most 10 %, and the off-axis median at most 15 %
+# of the prescribed motion (afm-build's summary line; the figures behind it
+# are the MPEG-4 table's, checked against the targets in tests/fap,
+# EachTargetMovesItsFdpByReferenceTimesFapuAlongTheFapsDirection). Song's
+# are checked in test_song.sh. Before the seventy-sixth session the 2k
+# head's worst was 20.5 % (its brows drawn apart), the 10k head's 36.2 %
+# (its outer lower lip lowered). Not under the sanitizers: two whole AFMs
+# take a few seconds here and minutes there, and the figures are the same.
+test_name=test_fidelity.sh
+. "$(dirname "$0")/lib/common.sh"
+
+if [ "${AFM_CONFIG:-release}" = sanitize ]; then
+  echo "test_fidelity.sh: skipped under the sanitizers (two whole AFMs; the release run checks the figures)"
+  exit 0
+fi
+
+for n in 2000 10000; do
+  "$bin/afm-headgen" --vertices $n -o "$tmp/h$n.wrl" >/dev/null 2>&1 || fail "afm-headgen --vertices $n failed"
+  "$bin/afm-build" "$tmp/h$n.wrl" "$tmp/h$n.fdp" -q --threads 2 -o "$tmp/h$n.afm" >"$tmp/h$n.txt" 2>&1 ||
+    fail "the $n-vertex head's build failed: $(tail -n 5 "$tmp/h$n.txt")"
+  fidelity_goals "$tmp/h$n.txt" "the $n-vertex head"
+done
+finish
