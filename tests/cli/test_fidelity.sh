@@ -6,11 +6,12 @@
 # of the prescribed motion (afm-build's summary line; the figures behind it
 # are the MPEG-4 table's, checked against the targets in tests/fap,
 # EachTargetMovesItsFdpByReferenceTimesFapuAlongTheFapsDirection). Song's
-# are checked in test_song.sh. Then no target turns a skin triangle over
-# but the lower lip's in-betweens at -1024. Before the seventy-sixth session the 2k
+# are checked in test_song.sh. Before the seventy-sixth session the 2k
 # head's worst was 20.5 % (its brows drawn apart), the 10k head's 36.2 %
-# (its outer lower lip lowered). Not under the sanitizers: two whole AFMs
-# take a few seconds here and minutes there, and the figures are the same.
+# (its outer lower lip lowered). Then no target turns a skin triangle over
+# but the lower lip's in-betweens at -1024. Not under the sanitizers: the
+# two whole AFMs with their reports take 17 s here and many minutes there,
+# and the figures are the same.
 test_name=test_fidelity.sh
 . "$(dirname "$0")/lib/common.sh"
 

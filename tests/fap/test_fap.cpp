@@ -1699,11 +1699,11 @@ TEST(FapSynthesis, TheChinRaiserTakesTheChinBossToItsReference) {
 // it: the 1k head 73 %, Song and the 10k head all of it (muscle_table.cpp).
 // Past its range the search stops short of where the skin folds: one solve
 // to 3/4 of the chord's unfolded share took the 1k head 87 % of the way; the
-// two that then halve the gap to the fold (kFoldBisections) 94 %. The fold
-// there is a whole triangle beside the brow, buckled: judged as the target
-// would store it, untangled (SkinFaults::breaks instead of tears), the pose
-// past it is a face, and steered from there the brow reaches the reference
-// with none turned.
+// two that then halve the gap to the fold (kFoldBisections) 94 %. Those
+// folds were judged torn (SkinFaults::tears: over 1e-4 of the skin turned,
+// a whole triangle or two) and not untangled; judged as the target would
+// store them, untangled (SkinFaults::breaks), the poses past them pass,
+// and steered from there the brow reaches the reference with none turned.
 TEST(FapSynthesis, TheCorrugatorsPushSpreadsTheBrowsAsFarAsTheTissueLets) {
   const Built &b = head_1k();
   FapSynthesisOptions o;
