@@ -79,10 +79,11 @@
 // Visemes and expressions (fap_mapping.h, HighLevelMapping): the table's
 // muscles and jaw opening posed once; the target holds the skin and, when
 // the jaw opens, the jaw's rigid parts carried by it (these targets have no
-// rigid control). Where that pose tears the skin (SkinFaults::tears), the
-// muscles to blame (their influence holds the largest turned or stretched
-// triangles or a sunk vertex; both sides of a pair) are bisected to the
-// largest share that does not, to a sixteenth, the others kept; failing
+// rigid control). Where that pose tears the skin (SkinFaults::tears), or
+// keeps a triangle turned once untangled as it is stored, the muscles to
+// blame (their influence holds the largest turned or stretched triangles
+// or a sunk vertex; both sides of a pair) are bisected to the largest
+// share that does neither, to a sixteenth, the others kept; failing
 // that, everything together. The outcome's message says what is made at
 // what share.
 //
@@ -95,9 +96,10 @@
 // where the FDP moves the wrong way at s = 1: the load control steers an
 // action that grows with the load, or where it moves less than a FAP unit);
 // its pose is kept if the skin stays a face as the target would store it,
-// its slivers untangled (untangle.h, with the FAP's FDP fixed; not where
-// the turned skin tears, SkinFaults::tears, nor at the lip corners, where
-// streams add the targets' slivers up to folds): face_model.h, skin_faults: no skin
+// the triangles it turns untangled (untangle.h, with the FAP's FDP fixed;
+// not where the skin sinks or stretches past a tear, SkinFaults::breaks,
+// nor at the lip corners, where streams add the targets' slivers up to
+// folds): face_model.h, skin_faults: no skin
 // triangle turned over, nothing below the skull; on a simulation mesh,
 // none of the lifted skin's either (FapSynthesisOptions::sim). Where it
 // does not, a pose short of the fold that does (one more solve, to 3/4 of
