@@ -48,7 +48,13 @@ Untangled untangle(const Eigen::MatrixXd &V0, const Eigen::MatrixXi &F, const st
   const size_t n = static_cast<size_t>(V0.rows());
   std::vector<int> root(n);
   std::iota(root.begin(), root.end(), 0);
-  std::vector<char> member(n, 0), rigid(n, 0), pinned(n, 0);
+  // pinned: the patch holds a held or fixed vertex; fixed_in: a fixed one.
+  std::vector<char> member(n, 0), rigid(n, 0), pinned(n, 0), fixed_in(n, 0);
+  // How far a held patch may move (kHeldPatchShare of the mean rest edge).
+  double mean_edge = 0;
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) mean_edge += (V0.row(F(f, (k + 1) % 3)) - V0.row(F(f, k))).norm();
+  const double held_reach = kHeldPatchShare * mean_edge / std::max<double>(1, 3.0 * static_cast<double>(F.rows()));
   auto find = [&root](int v) {
     while (root[static_cast<size_t>(v)] != v)
       v = root[static_cast<size_t>(v)] = root[static_cast<size_t>(root[static_cast<size_t>(v)])];
@@ -61,6 +67,7 @@ Untangled untangle(const Eigen::MatrixXd &V0, const Eigen::MatrixXi &F, const st
     root[o] = static_cast<int>(r);
     rigid[r] = rigid[r] || rigid[o];
     pinned[r] = pinned[r] || pinned[o];
+    fixed_in[r] = fixed_in[r] || fixed_in[o];
   };
   // The coarse vertices a turned triangle stands for: its corners, or for a
   // lifted one the coarse vertices its corners are bound to.
@@ -96,6 +103,7 @@ Untangled untangle(const Eigen::MatrixXd &V0, const Eigen::MatrixXi &F, const st
         for (int v : c) {
           member[static_cast<size_t>(v)] = 1;
           if (!hold.empty() && hold[static_cast<size_t>(v)] != kUntangleFree) pinned[static_cast<size_t>(find(v))] = 1;
+          if (!hold.empty() && hold[static_cast<size_t>(v)] == kUntangleFixed) fixed_in[static_cast<size_t>(find(v))] = 1;
           join(c[0], v);
         }
       }
@@ -105,7 +113,7 @@ Untangled untangle(const Eigen::MatrixXd &V0, const Eigen::MatrixXi &F, const st
     D = original;
     for (size_t r = 0; r < n; ++r) {
       const std::vector<int> &p = patches[r];
-      if (p.empty() || pinned[r]) continue;  // a patch holding a held or fixed vertex stays as solved
+      if (p.empty() || fixed_in[r]) continue;  // a patch holding a fixed vertex stays as solved
       // The affine motion nearest the solved one (least squares, the
       // minimum-norm one where the patch is flat), or one translation, the
       // mean, for a patch that turned inside.
@@ -122,6 +130,8 @@ Untangled untangle(const Eigen::MatrixXd &V0, const Eigen::MatrixXi &F, const st
       if (rigid[r] || m < 4) W.row(3) = Y.colwise().mean();
       else W = X.completeOrthogonalDecomposition().solve(Y);
       const Eigen::MatrixXd fit = X * W;
+      // A held patch (skin held off an eyeball) moves only a little.
+      if (pinned[r] && (fit - Y).rowwise().norm().maxCoeff() > held_reach) continue;
       for (Eigen::Index i = 0; i < m; ++i) D.row(p[static_cast<size_t>(i)]) = fit.row(i);
     }
     if (better(count(D))) best = D;

@@ -15,13 +15,19 @@
 // triangle still turns moves as one piece instead (the mean of its
 // members' motion), which turns nothing inside. Triangles that turn then,
 // at a patch's edge, join it in the next round, until nothing turns or
-// kUntangleMaxRounds. A patch holding a vertex marked held or fixed (a
-// FAP's own FDP, which keeps the motion it was measured by, is fixed; the
-// skin the solver holds off an eyeball is held) stays as solved: moved with
-// the FDP, as one piece or as a harmonic blend, the skin around the 10k
-// head's lower lip FDP went 7 mm, and a patch of Song's closing upper lid,
-// moved affinely, left a hole in it. The rest shape is kept; only the motion
-// within the patches changes. Where the solve tears a corner apart (Song's
+// kUntangleMaxRounds. A patch holding a vertex marked fixed (a FAP's own
+// FDP, which keeps the motion it was measured by) stays as solved: moved
+// with the FDP, as one piece or as a harmonic blend, the skin around the
+// 10k head's lower lip FDP went 7 mm. A patch holding a vertex marked held
+// (the skin the solver holds off an eyeball) moves only where that changes
+// none of its vertices by more than kHeldPatchShare of the mesh's mean rest
+// edge, else stays as solved: moved without that bound, a patch of Song's
+// closing upper lid left a hole in it, and its lids' in-betweens at 1024
+// changed 49-53 vertices by up to 3.9 units. Held patches that stayed as
+// solved stopped Song's brows lowered (31, 32, 34) at 94-99 % of their
+// reference, the search past their range judging a pose by its untangled
+// skin; now they reach it. The rest shape is kept; only the motion within
+// the patches changes. Where the solve tears a corner apart (Song's
 // mouth corner: the lower lip, carried by the jaw, moves 1.6 mm from the
 // upper one, which stays, within a millimetre) the change is about half of
 // that jump.
@@ -63,13 +69,14 @@ namespace afmb {
 
 constexpr int kUntangleMaxRounds = 32;  // then it gives up, keeping the best round
 constexpr double kSliverShare = 0.25;    // the most a sliver's apex moves, of its longest edge
+constexpr double kHeldPatchShare = 0.25; // the most a held patch's vertex moves, of the mean rest edge
 constexpr double kNearTurnArea = 0.02;   // a sliver: under this share of the mean triangle's area
 constexpr double kNearTurnCos = 0.3;     // nearly edge-on: turned more than 72.5 degrees from its rest facing
 
 // What untangle() may do with a vertex's motion.
 enum UntangleHold : char {
   kUntangleFree = 0,   // anything
-  kUntangleHeld = 1,   // its patch stays as solved; as a sliver's apex it may move
+  kUntangleHeld = 1,   // its patch moves within kHeldPatchShare, else stays as solved; as a sliver's apex it may move
   kUntangleFixed = 2,  // nothing
 };
 
