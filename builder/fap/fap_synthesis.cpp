@@ -374,8 +374,8 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
   for (int fap = 3; fap <= AFM_FAP_COUNT; ++fap)
     if (const afm_fap_info *info = afm_fap(fap); info && lip_corner_fdp(info))
       if (const int v = fdp_vertex(model, info); v >= 0) corner[static_cast<size_t>(v)] = 1;
-  auto target_faults = [&](const Eigen::MatrixXd &E, int fdp) {
-    SkinFaults f = face_faults(E);
+  // (untangled_faults: the same with E's raw faults `f` at hand.)
+  auto untangled_faults = [&](const Eigen::MatrixXd &E, int fdp, SkinFaults f) {
     if ((f.turned_faces.empty() && f.lifted_turned_faces.empty()) || f.breaks() ||
         (fdp >= 0 && corner[static_cast<size_t>(fdp)]))
       return f;
@@ -383,6 +383,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     untangle(rest, skin.F, target_hold(fdp), options.sim, D);
     return face_faults(rest + D);
   };
+  auto target_faults = [&](const Eigen::MatrixXd &E, int fdp) { return untangled_faults(E, fdp, face_faults(E)); };
 
   // How far the input's skin, lifted from a coarse displacement Dc (#Vc x
   // 3), sinks below the clearance the solver would hold it at off the
@@ -570,7 +571,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       auto torn = [&](const Pose &p, SkinFaults *faults = nullptr) {
         const Eigen::MatrixXd E = pose_epidermis(model, p);
         SkinFaults f = face_faults(E);
-        const bool bad = f.tears() || (f.any() && target_faults(E, -1).any());
+        const bool bad = f.tears() || (f.any() && untangled_faults(E, -1, f).any());
         if (faults) *faults = std::move(f);
         return bad;
       };
