@@ -408,6 +408,8 @@ Expected<std::vector<uint8_t>> encode_afm(const AfmContent &content, afm_profile
     a.number = static_cast<uint8_t>(mt.number);
     a.flags = mt.normals ? AFM_TARGET_NORMALS : 0;
     a.reference = mt.reference;
+    a.gate = static_cast<uint8_t>(mt.gate);
+    a.gate_reference = mt.gate_reference;
     a.run_count = static_cast<uint32_t>(s.runs.size());
     a.runs = s.runs.data();
     a.delta_count = static_cast<uint32_t>(s.d[0].size());

@@ -28,6 +28,11 @@ struct MorphTarget {
   afm_target_kind kind = AFM_TARGET_FAP;
   int number = 0;          // FAP 3..68, viseme 1..14, expression 1..6
   int32_t reference = 0;   // FAP units (63 for visemes and expressions); < 0: negative side
+  // AFM_TARGET_COMBINATION: a correction on top of the FAP target at
+  // (number, reference), gated by FAP `gate` at `gate_reference` (formats/afm.md,
+  // MTGT "Combinations"); 0 for other kinds.
+  int gate = 0;
+  int32_t gate_reference = 0;
   // Per part: #V x 3 displacement in model units, or an empty matrix when the
   // part does not move.
   std::vector<Eigen::MatrixXd> displacement;

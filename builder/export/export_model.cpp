@@ -78,7 +78,12 @@ std::string target_name(const afm_target &t) {
   }
   const afm_fap_info *f = afm_fap(t.number);
   std::string name = f ? f->name : "fap_" + std::to_string(t.number);
-  return t.reference < 0 ? name + "_neg" : name;
+  if (t.reference < 0) name += "_neg";
+  if (t.kind == AFM_TARGET_COMBINATION) {
+    const afm_fap_info *g = afm_fap(t.gate);
+    name += "_" + std::to_string(std::abs(t.reference)) + "_with_" + (g ? g->name : "fap_" + std::to_string(t.gate));
+  }
+  return name;
 }
 
 std::vector<std::string> target_names(const afm_doc &doc) {

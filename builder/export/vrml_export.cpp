@@ -11,7 +11,10 @@ namespace afmb {
 namespace {
 
 const char *kind_word(uint8_t kind) {
-  return kind == AFM_TARGET_VISEME ? "viseme" : kind == AFM_TARGET_EXPRESSION ? "expression" : "fap";
+  return kind == AFM_TARGET_VISEME        ? "viseme"
+         : kind == AFM_TARGET_EXPRESSION  ? "expression"
+         : kind == AFM_TARGET_COMBINATION ? "combination"
+                                          : "fap";
 }
 
 // A DEF name not yet used in the file (target names are legal VRML ids).
@@ -69,7 +72,11 @@ Expected<std::string> vrml_afm_text(const afm_doc &doc, const std::string &sourc
   for (uint32_t t = 0; t < doc.target_count; ++t) {
     const afm_target &at = doc.targets[t];
     std::string line = "target " + names[t] + " " + kind_word(at.kind) + " " + std::to_string(at.number) +
-                       " reference " + std::to_string(at.reference) + " parts";
+                       " reference " + std::to_string(at.reference) +
+                       (at.kind == AFM_TARGET_COMBINATION ? " gate " + std::to_string(at.gate) + " gate_reference " +
+                                                                std::to_string(at.gate_reference)
+                                                          : std::string()) +
+                       " parts";
     for (const Part &p : targets[t].parts) line += " " + p.name.substr(names[t].size() + 2);
     out += "    " + vrml_string(line) + ",\n";
   }

@@ -324,7 +324,7 @@ bool solved_fap_target(const FapOutcome &o) {
 }
 
 bool solved_own_pose(const FapOutcome &o) {
-  return o.made && !o.holds && (o.kind != AFM_TARGET_FAP || solved_fap_target(o));
+  return o.made && !o.holds && (o.kind == AFM_TARGET_VISEME || o.kind == AFM_TARGET_EXPRESSION || solved_fap_target(o));
 }
 
 Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &model, const FapSynthesisOptions &options) {
@@ -1509,7 +1509,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
   // that keeps its skin in front of the lower teeth (#n, z:
   // teeth_clearance.h) and its reference are kept: past their reach the
   // lower lip's FAPs go on with it.
-  Eigen::VectorXd lip_given_up, lip_pushed;
+  Eigen::VectorXd lip_given_up, lip_pushed, lip_kept;
   int given_up_at = 0;
   std::optional<TeethClearance> teeth;
   {
@@ -1523,6 +1523,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       if (work[k].reference > given_up_at) {
         given_up_at = work[k].reference;
         lip_given_up = D.col(1).cwiseProduct((1 - hold.share.array()).matrix());
+        lip_kept = hold.share;
       }
       keep_lip_height(hold, D);
       // The teeth turn down behind the held lip (teeth_clearance.h).
@@ -1600,30 +1601,36 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     return std::make_pair(std::move(base), std::move(b));
   };
   // A lower lip FAP's negative side past its target (jaw_lips.h, "Past
-  // the lip's reach"): an in-between at FAP 3's farthest reference, the
-  // side's pose plus the height FAP 3's target gave up there, times the
-  // side's share of the split skin, scaled so the FDP reaches that value.
+  // the lip's reach"): at FAP 3's farthest reference, an in-between holding
+  // the side's pose, and a combination gated by FAP 3 (formats/afm.md): the
+  // height FAP 3's target gave up there, times the side's share of the
+  // split skin, scaled so that with the in-between the FDP reaches that
+  // value. Alone the lip holds; with the jaw it goes on as far as the jaw
+  // opens.
+  using Made = std::pair<MorphTarget, FapOutcome>;
   auto lip_past_reach = [&](size_t k, const MorphTarget &t, const FapOutcome &o,
-                            const std::vector<char> &hold) -> std::optional<std::pair<MorphTarget, FapOutcome>> {
+                            const std::vector<char> &hold) -> std::vector<Made> {
     const FapMapping *f = work[k].fap;
     if (!f || f->driver != FapDriver::Muscles || work[k].side > 0 || work[k].in_between || !o.made ||
         !lower_lip_fap(f->fap) || lip_given_up.size() != skin.n || std::abs(o.reference) >= given_up_at)
-      return std::nullopt;
+      return {};
     const afm_fap_info *info = afm_fap(f->fap);
     const int v = fdp_vertex(model, info);
     const Eigen::MatrixXd &D = t.displacement[static_cast<size_t>(model.skin)];
-    if (v < 0 || D.rows() != skin.n) return std::nullopt;
+    if (v < 0 || D.rows() != skin.n) return {};
     const Eigen::Vector3d along = work[k].side * fap_direction(info);
     const double unit = o.prescribed.dot(along) / std::abs(o.reference);
     Eigen::VectorXd G = lip_given_up;
     if (skin_share[k].size() == skin.n) G.array() *= skin_share[k].array();
     const double own = D.row(v).dot(along.transpose()), more = G(v) * along.y();
     const double alpha = (given_up_at * unit - own) / more;
-    if (!(more > 0) || !(alpha > 0)) return std::nullopt;
-    std::pair<MorphTarget, FapOutcome> far{t, o};
-    MorphTarget &ft = far.first;
-    FapOutcome &fo = far.second;
-    Eigen::MatrixXd &E = ft.displacement[static_cast<size_t>(model.skin)];
+    if (!(more > 0) || !(alpha > 0)) return {};
+    // E: the side's pose with the jaw's height, what the hold and the
+    // combination add up to with the jaw open as far. Below the lip the
+    // side's own motion gives way to the jaw's as the share FAP 3 keeps
+    // there (s) grows: taken down by both, the skin above Song's chin went
+    // past the chin (2 triangles turned, played with the jaw at 1024).
+    Eigen::MatrixXd E = D.array().colwise() * (1 - lip_kept.array());
     E.col(1) += alpha * G;
     // The push over the teeth that FAP 3's target made goes with the hold;
     // in front of the closed teeth the skin keeps its clearance.
@@ -1636,30 +1643,51 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     std::vector<char> h = hold;
     h[static_cast<size_t>(v)] = kUntangleFixed;
     untangle(rest, skin.F, h, options.sim, E);
-    for (const SkinBinding &b : carried) ft.displacement[static_cast<size_t>(b.part)] = Eigen::MatrixXd();
-    carry(E, ft);
-    ft.reference = work[k].side * given_up_at;
-    fo.reference = ft.reference;
-    fo.in_between = true;
-    fo.holds = fo.at_reach = false;
-    fo.from_jaw = true;
-    fo.reached = 1;
-    fo.seconds = 0;
-    fo.slabs = 0;  // not solved: FAP 3's skin carried
-    fo.prescribed = given_up_at * unit * along;
-    measure(fo, E.row(v).transpose(), fap_direction(info));
-    const SkinFaults faults = skin_faults(model, rest + E);
-    fo.turned = static_cast<int>(faults.turned_faces.size());
-    fo.sunk = static_cast<int>(faults.sunk_vertices.size());
-    fo.message = "past the side's target the lip goes on as FAP 3 at " + std::to_string(given_up_at) +
-                 " would carry it, by this FAP's share (jaw_lips.h)";
-    return far;
+    std::vector<Made> made(2, Made{t, o});
+    // The hold: the side's pose to FAP 3's farthest reference.
+    MorphTarget &ht = made[0].first;
+    FapOutcome &ho = made[0].second;
+    ht.reference = work[k].side * given_up_at;
+    ho.reference = ht.reference;
+    ho.in_between = ho.from_jaw = true;
+    ho.holds = ho.at_reach = false;
+    ho.seconds = 0;
+    ho.slabs = 0;  // the side's pose, counted once
+    ho.prescribed = given_up_at * unit * along;
+    measure(ho, D.row(v).transpose(), fap_direction(info));
+    ho.reached = D.row(v).dot(along.transpose()) / (given_up_at * unit);
+    ho.message = "holds the side's pose to " + std::to_string(ht.reference) +
+                 "; with the jaw open the combination below goes on";
+    // The combination: E less the hold, gated by FAP 3.
+    MorphTarget &ct = made[1].first;
+    FapOutcome &co = made[1].second;
+    ct.kind = co.kind = AFM_TARGET_COMBINATION;
+    ct.reference = ht.reference;
+    ct.gate = 3;
+    ct.gate_reference = given_up_at;
+    for (Eigen::MatrixXd &d : ct.displacement) d = Eigen::MatrixXd();
+    ct.displacement[static_cast<size_t>(model.skin)] = E - D;
+    carry(E - D, ct);
+    co.reference = ct.reference;
+    co.in_between = co.from_jaw = true;
+    co.holds = co.at_reach = false;
+    co.reached = 1;
+    co.seconds = 0;
+    co.slabs = 0;  // not solved: FAP 3's skin carried
+    co.prescribed = given_up_at * unit * along;
+    measure(co, E.row(v).transpose(), fap_direction(info));
+    // Judged as played below, with the other lip sides and the jaw.
+    co.sunk = static_cast<int>(skin_faults(model, rest + E).sunk_vertices.size());
+    co.message = "with FAP 3 at " + std::to_string(given_up_at) + " the lip goes on as the jaw would carry it, by " +
+                 "this FAP's share (jaw_lips.h); gated by FAP 3's value";
+    return made;
   };
   // Each target's untangling, checks, reach and lip past its reach are its
   // own (on workers: a serial 0.2 s of Song's AFM); they join `out` in the
   // work list's order.
   struct Finished {
-    std::optional<std::pair<MorphTarget, FapOutcome>> reach, far, past;  // before and after the target
+    std::optional<std::pair<MorphTarget, FapOutcome>> reach, past;  // before and after the target
+    std::vector<std::pair<MorphTarget, FapOutcome>> far;  // after the target
   };
   std::vector<Finished> finished(results.size());
   for_each_task(results.size(), options.threads, [&](size_t k) {
@@ -1688,6 +1716,60 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       finished[k].far = lip_past_reach(k, t, r.outcome, hold);
     }
   });
+  // The lower lip's combinations as streams play them: FAP 3 at its
+  // farthest reference with every lower lip side there. Where that pose
+  // turns triangles, it is untangled once (the sides' FDPs and the chin's
+  // fixed) and the change shared among the combinations by the sides'
+  // shares of the split skin (Song: 2 triangles above the chin; none on the
+  // generated heads).
+  {
+    const size_t s0 = static_cast<size_t>(model.skin);
+    std::vector<size_t> lips;
+    const MorphTarget *jaw = nullptr;  // FAP 3's target at given_up_at, untangled as stored
+    for (size_t k = 0; k < results.size(); ++k) {
+      if (finished[k].far.size() == 2) lips.push_back(k);
+      if (work[k].fap && work[k].fap->driver == FapDriver::JawOpen && work[k].reference == given_up_at &&
+          results[k].target && results[k].target->displacement[s0].rows() == skin.n)
+        jaw = &*results[k].target;
+    }
+    if (!lips.empty() && jaw) {
+      auto share = [&](size_t k) -> Eigen::VectorXd {
+        return skin_share[k].size() == skin.n ? skin_share[k] : Eigen::VectorXd::Ones(skin.n);
+      };
+      Eigen::MatrixXd J = jaw->displacement[s0];
+      Eigen::VectorXd total = Eigen::VectorXd::Zero(skin.n);
+      std::vector<char> h = target_hold(fdp_vertex(model, afm_fap(3)));  // the chin keeps FAP 3's motion
+      for (size_t k : lips) {
+        J += finished[k].far[0].first.displacement[s0] + finished[k].far[1].first.displacement[s0];
+        total += share(k);
+        const int v = fdp_vertex(model, afm_fap(work[k].fap->fap));
+        if (v >= 0) h[static_cast<size_t>(v)] = kUntangleFixed;
+      }
+      Eigen::MatrixXd U = J;
+      const Untangled u = untangle(rest, skin.F, h, options.sim, U);
+      const int turned = static_cast<int>(skin_faults(model, rest + U).turned_faces.size());
+      for (size_t k : lips) {
+        MorphTarget &ct = finished[k].far[1].first;
+        FapOutcome &co = finished[k].far[1].second;
+        if (u.moved > 0) {
+          Eigen::VectorXd w = share(k);
+          for (Eigen::Index i = 0; i < w.size(); ++i)
+            w(i) = total(i) > 0 ? w(i) / total(i) : 1.0 / static_cast<double>(lips.size());
+          Eigen::MatrixXd &K = ct.displacement[s0];
+          K.array() += (U - J).array().colwise() * w.array();
+          for (const SkinBinding &b : carried) ct.displacement[static_cast<size_t>(b.part)] = Eigen::MatrixXd();
+          carry(K, ct);
+          char what[200];
+          std::snprintf(what, sizeof what,
+                        "; played with the other lip sides and FAP 3, %d turned triangles untangled, its share of "
+                        "the change by up to %.2g",
+                        u.turned_before - u.turned_after, u.largest_change);
+          co.message += what;
+        }
+        co.turned = turned;
+      }
+    }
+  }
   // Held past the reference (fap_synthesis.h): a lip corner's side whose
   // target, summed with its partners' at the same value (the FAPs that move
   // its FDP the same way) and taken kCornerStreamReach times as far, turns
@@ -1744,9 +1826,9 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     if (r.target) out.targets.push_back(std::move(*r.target));
     if (r.outcome.made) jaw_samples.insert(jaw_samples.end(), r.jaw.begin(), r.jaw.end());
     out.outcomes.push_back(std::move(r.outcome));
-    if (f.far) {
-      out.targets.push_back(std::move(f.far->first));
-      out.outcomes.push_back(std::move(f.far->second));
+    for (auto &m : f.far) {
+      out.targets.push_back(std::move(m.first));
+      out.outcomes.push_back(std::move(m.second));
     }
     if (f.past) {
       out.targets.push_back(std::move(f.past->first));
@@ -1780,14 +1862,36 @@ void lift_synthesis(FapSynthesis &synthesis, const SimMesh &sim) {
   synthesis.lift.parts[0].part = sim.skin;
   for (const SkinBinding &b : synthesis.carried) synthesis.lift.parts.push_back(b);
   size_t next = 0;  // targets are the made outcomes, in order
+  std::vector<std::pair<FapOutcome *, size_t>> combinations;
   for (FapOutcome &o : synthesis.outcomes) {
     if (!o.made) continue;
     MorphTarget &t = synthesis.targets[next++];
     if (skin >= t.displacement.size() || t.displacement[skin].rows() == 0) continue;
     t.controls = t.displacement[skin];
     t.displacement[skin] = lift_displacement(sim, t.controls);
+    if (t.kind == AFM_TARGET_COMBINATION) combinations.emplace_back(&o, next - 1);
     o.turned = static_cast<int>(turned_faces(sim.skin_V, sim.skin_F, sim.skin_V + t.displacement[skin]).size());
-    if (o.kind != AFM_TARGET_FAP) o.largest = t.displacement[skin].rowwise().norm().maxCoeff();
+    if (o.kind == AFM_TARGET_VISEME || o.kind == AFM_TARGET_EXPRESSION)
+      o.largest = t.displacement[skin].rowwise().norm().maxCoeff();
+  }
+  // A combination is judged as played: with every combination of its gate
+  // at the same reference, the targets they follow and the gate's.
+  for (auto [o, c] : combinations) {
+    const MorphTarget &ct = synthesis.targets[c];
+    Eigen::MatrixXd played = sim.skin_V;
+    for (const MorphTarget &t : synthesis.targets) {
+      if (skin >= t.displacement.size() || t.displacement[skin].rows() != played.rows()) continue;
+      const bool gate = t.kind == AFM_TARGET_FAP && t.number == ct.gate && t.reference == ct.gate_reference;
+      const bool partner = t.kind == AFM_TARGET_COMBINATION && t.gate == ct.gate &&
+                           t.gate_reference == ct.gate_reference && t.reference == ct.reference;
+      bool followed = false;
+      for (const MorphTarget &u : synthesis.targets)
+        followed |= t.kind == AFM_TARGET_FAP && u.kind == AFM_TARGET_COMBINATION && u.gate == ct.gate &&
+                    u.gate_reference == ct.gate_reference && u.reference == ct.reference &&
+                    t.number == u.number && t.reference == u.reference;
+      if (gate || partner || followed) played += t.displacement[skin];
+    }
+    o->turned = static_cast<int>(turned_faces(sim.skin_V, sim.skin_F, played).size());
   }
 }
 

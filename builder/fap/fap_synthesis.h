@@ -207,8 +207,10 @@ struct FapOutcome {
   bool holds = false;             // an in-between at the table's reference holding an
                                   // under-reaching side's pose ("Reach, then hold")
   bool at_reach = false;          // that side's target at the FAP units it reaches
-  bool from_jaw = false;          // a lower lip side's in-between past its reach, made from
-                                  // FAP 3's target (jaw_lips.h), not solved
+  bool from_jaw = false;          // a lower lip side past its reach (jaw_lips.h), not solved:
+                                  // its in-between at FAP 3's farthest reference holding the
+                                  // side's pose, or (kind AFM_TARGET_COMBINATION) what FAP 3's
+                                  // target adds to it there
   bool past_reference = false;    // an in-between past the table's reference holding a lip
                                   // corner's pose there ("Held past the reference")
   bool made = false;              // a target was made
@@ -245,8 +247,8 @@ struct FapOutcome {
 
 // Whether a made outcome is a FAP target the face model solved (muscles,
 // jaw, lids): the ones the fidelity figures summarise. The tongue's and the
-// pupils' (kinematic_fap) and the lower lip's in-betweens past its reach
-// (from_jaw) are exact by construction, a lip corner held past its
+// pupils' (kinematic_fap) and the lower lip's holds and combinations past
+// its reach (from_jaw) are exact by construction (with the jaw), a lip corner held past its
 // reference (past_reference) stores its reference's pose, and visemes and
 // expressions have no FDP rule.
 bool solved_fap_target(const FapOutcome &o);

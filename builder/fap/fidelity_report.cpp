@@ -44,13 +44,17 @@ std::string format(const char *fmt, ...) {
 std::string target_id(const FapOutcome &o) {
   if (o.kind == AFM_TARGET_VISEME) return format("v%d", o.number);
   if (o.kind == AFM_TARGET_EXPRESSION) return format("e%d", o.number);
+  if (o.kind == AFM_TARGET_COMBINATION) return format("%d+", o.number);
   return format("%d", o.number);
 }
 
-// "fap03", "fap03-neg", "viseme01", "expression1".
+// "fap03", "fap03-neg", "fap05-neg-1024", "fap05-neg-1024-with-fap03",
+// "viseme01", "expression1".
 std::string file_stem(const FapOutcome &o) {
   if (o.kind == AFM_TARGET_VISEME) return format("viseme%02d", o.number);
   if (o.kind == AFM_TARGET_EXPRESSION) return format("expression%d", o.number);
+  if (o.kind == AFM_TARGET_COMBINATION)
+    return format("fap%02d%s-%d-with-fap03", o.number, o.side < 0 ? "-neg" : "", std::abs(o.reference));
   if (o.in_between) return format("fap%02d%s-%d", o.number, o.side < 0 ? "-neg" : "", std::abs(o.reference));
   return format("fap%02d%s", o.number, o.side < 0 ? "-neg" : "");
 }
@@ -75,23 +79,22 @@ std::string csv_quote(const std::string &s) {
 
 // The FDP a FAP target is measured at (skin vertex), or -1.
 int fap_fdp_vertex(const FdpSet &fdps, int skin, const FapOutcome &o) {
-  if (o.kind != AFM_TARGET_FAP) return -1;
+  if (o.kind != AFM_TARGET_FAP && o.kind != AFM_TARGET_COMBINATION) return -1;
   const afm_fap_info *info = afm_fap(o.number);
   const FdpPoint *p = info ? fdps.find(FdpId{info->fdp_group, info->fdp_index}, skin) : nullptr;
   return p && p->part == skin ? p->vertex : -1;
 }
 
-// The jaw's rigid motion at a jaw FAP's reference value (identity for other
-// targets): the control the synthesis gave the jaw's parts.
-Eigen::Affine3d jaw_at_reference(const FapSynthesis &s, const FapOutcome &o) {
+// The jaw's rigid motion at FAP `fap`'s value (identity for FAPs that do
+// not move it): the controls the synthesis gave the jaw's parts.
+Eigen::Affine3d jaw_at(const FapSynthesis &s, int fap, int value) {
   Eigen::Affine3d t = Eigen::Affine3d::Identity();
-  if (o.kind != AFM_TARGET_FAP) return t;
   // As the player composes them: p' = R (p - pivot) + pivot + translation.
   Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
   Eigen::Vector3d move = Eigen::Vector3d::Zero();
   for (const RigidPart::Control &c : s.jaw.controls) {
-    if (c.fap != o.number) continue;
-    const double amount = c.gain * o.reference;
+    if (c.fap != fap) continue;
+    const double amount = c.gain * value;
     const Eigen::Vector3d a = s.jaw.axes.row(c.dof % 3).transpose();  // rows: local axes
     if (c.dof < 3) R = Eigen::AngleAxisd(amount * 1e-5, a).toRotationMatrix() * R;
     else move += amount * a;
@@ -108,7 +111,11 @@ std::string target_label(const FapOutcome &o) {
   if (o.kind == AFM_TARGET_EXPRESSION) return afm_expression_name(o.number);
   const afm_fap_info *info = afm_fap(o.number);
   return std::string(info ? info->name : "fap") + (o.side < 0 ? " (negative)" : "") +
-         (o.holds ? " (hold)" : o.past_reference ? " (held past)" : o.in_between ? " (in-between)" : "");
+         (o.kind == AFM_TARGET_COMBINATION ? " (with the jaw)"
+          : o.holds || o.from_jaw          ? " (hold)"
+          : o.past_reference               ? " (held past)"
+          : o.in_between                   ? " (in-between)"
+                                           : "");
 }
 
 std::string fidelity_table(const FapSynthesis &s) {
@@ -136,7 +143,7 @@ std::string fidelity_table(const FapSynthesis &s) {
       ++solved;
       if (o.slabs > 0) ++slab_turning, slabs += o.slabs;
     }
-    if (o.kind != AFM_TARGET_FAP) {
+    if (o.kind == AFM_TARGET_VISEME || o.kind == AFM_TARGET_EXPRESSION) {
       out += format("%-4s %-34s %6d %8s %10s %10.4g %8s %8s %7d %6d%s%s\n", id.c_str(), name.c_str(), o.reference,
                     "-", "-", o.largest, "-", "-", o.dynamic, o.turned, o.message.empty() ? "" : "  ",
                     o.message.c_str());
@@ -147,7 +154,8 @@ std::string fidelity_table(const FapSynthesis &s) {
       // construction, or a lip corner's target held past the table's
       // reference: listed, left out of the summary's figures (measured at
       // the references).
-      ++(o.from_jaw ? from_jaw : held_past);
+      if (o.kind == AFM_TARGET_COMBINATION) ++from_jaw;
+      if (o.past_reference) ++held_past;
       out += format("%-4s %-34s %6d %8s %10.4g %10.4g %7.2f%% %7.1f%% %7s %6d  %s\n", id.c_str(), name.c_str(),
                     o.reference, "-", o.prescribed.norm(), o.achieved.norm(), 100 * o.along_error, 100 * o.off_axis,
                     "-", o.turned, o.message.c_str());
@@ -197,8 +205,9 @@ std::string fidelity_table(const FapSynthesis &s) {
                                    kinematic)
                                   .c_str()
                           : "",
-                from_jaw ? format("; %d in-betweens past the lower lip's reach are made from the jaw's target, "
-                                  "exact along the direction by construction, and not in these figures",
+                from_jaw ? format("; %d lower lip sides hold their pose past their reach, and with the jaw go "
+                                  "on by a combination made from its target (exact along the direction by "
+                                  "construction): not in these figures",
                                   from_jaw)
                                  .c_str()
                          : "",
@@ -228,7 +237,10 @@ Status write_fidelity_report(const std::string &dir, const Scene &scene, const F
   for (const FapOutcome &o : s.outcomes)
     csv += format("%s,%d,%s,%d,%d,%.4g,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%d,%d,"
                   "%.3f,",
-                  o.kind == AFM_TARGET_FAP ? "fap" : o.kind == AFM_TARGET_VISEME ? "viseme" : "expression",
+                  o.kind == AFM_TARGET_FAP           ? "fap"
+                  : o.kind == AFM_TARGET_VISEME      ? "viseme"
+                  : o.kind == AFM_TARGET_COMBINATION ? "combination"
+                                                     : "expression",
                   o.number, csv_quote(target_label(o)).c_str(), o.side, o.reference, o.reached, o.made ? 1 : 0,
                   o.scale, o.prescribed.x(), o.prescribed.y(), o.prescribed.z(), o.achieved.x(), o.achieved.y(),
                   o.achieved.z(), o.along_error, o.off_axis, o.off_face, o.off_depth, o.largest, o.dynamic,
@@ -334,9 +346,26 @@ Status write_fidelity_report(const std::string &dir, const Scene &scene, const F
     if (!o.made) continue;
     const MorphTarget &t = s.targets[next++];
     Scene posed = scene;
-    const Eigen::Affine3d jaw = jaw_at_reference(s, o);
-    for (size_t p = 0; p < posed.parts.size() && p < t.displacement.size(); ++p)
-      if (t.displacement[p].rows() == posed.parts[p].V.rows()) posed.parts[p].V += t.displacement[p];
+    // A combination as played and judged (lift_synthesis): with the other
+    // combinations of its gate at its reference, the targets they follow
+    // and the gate's.
+    std::vector<const MorphTarget *> shown = {&t};
+    if (t.kind == AFM_TARGET_COMBINATION)
+      for (const MorphTarget &u : s.targets) {
+        bool with = u.kind == AFM_TARGET_FAP && u.number == t.gate && u.reference == t.gate_reference;
+        for (const MorphTarget &c : s.targets)
+          if (c.kind == AFM_TARGET_COMBINATION && c.gate == t.gate && c.gate_reference == t.gate_reference &&
+              c.reference == t.reference)
+            with |= (&u == &c && &u != &t) ||
+                    (u.kind == AFM_TARGET_FAP && u.number == c.number && u.reference == c.reference);
+        if (with) shown.push_back(&u);
+      }
+    const Eigen::Affine3d jaw = t.kind == AFM_TARGET_COMBINATION ? jaw_at(s, t.gate, t.gate_reference)
+                                : o.kind == AFM_TARGET_FAP       ? jaw_at(s, o.number, o.reference)
+                                                                 : Eigen::Affine3d::Identity();
+    for (const MorphTarget *u : shown)
+      for (size_t p = 0; p < posed.parts.size() && p < u->displacement.size(); ++p)
+        if (u->displacement[p].rows() == posed.parts[p].V.rows()) posed.parts[p].V += u->displacement[p];
     if (!jaw.matrix().isIdentity(0))
       for (int p : s.jaw.parts) {
         Eigen::MatrixXd &V = posed.parts[static_cast<size_t>(p)].V;
@@ -403,7 +432,7 @@ Status write_fidelity_report(const std::string &dir, const Scene &scene, const F
     html += format("<td>%d</td>", o.reference);
     if (!o.made) {
       html += "<td colspan=5></td>";
-    } else if (o.kind != AFM_TARGET_FAP) {
+    } else if (o.kind == AFM_TARGET_VISEME || o.kind == AFM_TARGET_EXPRESSION) {
       html += format("<td></td><td></td><td>%.4g</td><td></td><td></td>", o.largest);
     } else {
       html += format("<td>%.3f</td><td>%.4g</td><td>%.4g</td><td>%.2f%%</td><td>%.1f%% (%.1f%% across, %.1f%% "

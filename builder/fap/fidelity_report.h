@@ -13,7 +13,11 @@
 //                  (reference value), the skin tinted red where it moves
 //                  (full red at the target's largest motion); for a FAP,
 //                  its FDP at rest (yellow) and where MPEG-4 puts it at the
-//                  reference (green); neutral.png is the face at rest
+//                  reference (green); a combination (the lower lip past
+//                  its reach with the jaw) as played, with the other lower
+//                  lip sides' and FAP 3's at its reference, red where it
+//                  adds;
+//                  neutral.png is the face at rest
 //   sheet.png      a contact sheet of those pictures, neutral first, then in
 //                  the table's order (row by row)
 //   index.html     the table with the pictures beside each row
@@ -37,8 +41,8 @@ std::string target_label(const FapOutcome &outcome);
 // where it has one (why it was not made, how far it under-reaches, which
 // helpers steered it, what was untangled), then one summary line: targets
 // made and not, and over the FAP targets the model solved (solved_fap_target:
-// the tongue's and the pupils', and the lower lip's in-betweens past its
-// reach, are listed apart, exact by construction) the
+// the tongue's and the pupils', and the lower lip's holds and combinations
+// past its reach, are listed apart, exact by construction) the
 // median and worst error along the direction and off it, and the medians of
 // the off-axis parts across the face and in depth. Each FAP side counts once,
 // at the table's reference: a held side (fap_synthesis.h, "Reach, then

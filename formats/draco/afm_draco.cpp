@@ -615,6 +615,10 @@ afm_result mtgt_from_raw(const uint8_t *raw, size_t raw_size, const afm_allocato
     o.u32(static_cast<uint32_t>(t.reference));
     o.u32(t.run_count);
     o.u32(t.delta_count);
+    if (t.kind == AFM_TARGET_COMBINATION) {
+      o.u32(t.gate);  // as raw: u8 gate, u8 0, u16 0
+      o.u32(static_cast<uint32_t>(t.gate_reference));
+    }
     for (uint32_t k = 0; k < t.run_count; ++k) {
       o.u32(t.runs[k].start);
       o.u32(t.runs[k].length);
@@ -663,6 +667,12 @@ afm_result mtgt_to_raw(const uint8_t *data, size_t size, const afm_allocator *al
     t.reference = static_cast<int32_t>(in.u32());
     t.run_count = in.u32();
     t.delta_count = in.u32();
+    if (t.kind == AFM_TARGET_COMBINATION) {
+      const uint32_t gate = in.u32();
+      t.gate = static_cast<uint8_t>(gate);  // the raw reader checks the rest
+      t.gate_reference = static_cast<int32_t>(in.u32());
+      if (gate > 0xFFu) in.ok = false;
+    }
     if (!in.ok || t.run_count > (size - in.pos) / 8) {
       in.ok = false;
       break;

@@ -9,6 +9,7 @@ static int number_valid(uint8_t kind, uint8_t number) {
     case AFM_TARGET_FAP: return number >= 3 && number <= 68;
     case AFM_TARGET_VISEME: return number >= 1 && number <= 14;
     case AFM_TARGET_EXPRESSION: return number >= 1 && number <= 6;
+    case AFM_TARGET_COMBINATION: return number >= 3 && number <= 68;
     default: return 0;
   }
 }
@@ -18,6 +19,7 @@ static const char *kind_text(uint8_t kind) {
     case AFM_TARGET_FAP: return "FAP";
     case AFM_TARGET_VISEME: return "viseme";
     case AFM_TARGET_EXPRESSION: return "expression";
+    case AFM_TARGET_COMBINATION: return "combination of FAP";
     default: return "?";
   }
 }
@@ -57,14 +59,29 @@ afm_result afm_targets_decode_at(const uint8_t *raw, size_t size, uint64_t file_
     if (t.flags & ~(uint8_t)AFM_TARGET_NORMALS)
       return afm_fail(&r, AFM_ERR_RANGE, "target %lu: unknown flags 0x%x", (unsigned long)i,
                       (unsigned)t.flags);
-    if (t.reference == 0 || (t.kind != AFM_TARGET_FAP && t.reference < 0))
+    if (t.kind == AFM_TARGET_COMBINATION) {
+      /* The gate (since 1.4): u8 gate, u8 0, u16 0, i32 gate_reference. */
+      uint32_t reserved;
+      t.gate = afm_read_u8(&r, "target.gate");
+      reserved = afm_read_u8(&r, "target.gate_reserved");
+      reserved |= afm_read_u16(&r, "target.gate_reserved");
+      t.gate_reference = afm_read_i32(&r, "target.gate_reference");
+      if (r.error != AFM_OK) return r.error;
+      if (reserved != 0)
+        return afm_fail(&r, AFM_ERR_RANGE, "target %lu: gate's reserved bytes not zero", (unsigned long)i);
+      if (t.gate < 3 || t.gate > 68 || t.gate == t.number || t.gate_reference == 0)
+        return afm_fail(&r, AFM_ERR_RANGE, "target %lu (combination of FAP %u): gate FAP %u at %ld",
+                        (unsigned long)i, (unsigned)t.number, (unsigned)t.gate, (long)t.gate_reference);
+    }
+    if (t.reference == 0 || (t.kind != AFM_TARGET_FAP && t.kind != AFM_TARGET_COMBINATION && t.reference < 0))
       return afm_fail(&r, AFM_ERR_RANGE, "target %lu (%s %u): reference value %ld",
                       (unsigned long)i, kind_text(t.kind), (unsigned)t.number, (long)t.reference);
     /* A FAP side may have several targets (in-betweens, version 1.2), each
      * at its own reference; a viseme or an expression has one. */
     for (j = 0; targets && j < i; ++j)
       if (targets[j].kind == t.kind && targets[j].number == t.number &&
-          (t.kind != AFM_TARGET_FAP || targets[j].reference == t.reference))
+          ((t.kind != AFM_TARGET_FAP && t.kind != AFM_TARGET_COMBINATION) ||
+           targets[j].reference == t.reference))
         return afm_fail(&r, AFM_ERR_RANGE, "target %lu: %s %u (reference %ld) appears twice",
                         (unsigned long)i, kind_text(t.kind), (unsigned)t.number,
                         (long)t.reference);
@@ -97,6 +114,19 @@ afm_result afm_targets_decode_at(const uint8_t *raw, size_t size, uint64_t file_
   if (afm_remaining(&r) != 0)
     return afm_fail(&r, AFM_ERR_TRAILING_BYTES, "%lu bytes after the last target",
                     (unsigned long)afm_remaining(&r));
+  /* A combination follows the FAP target at its number and reference. On
+   * the measuring pass (no targets kept) this check waits for the read. */
+  for (i = 0; targets && i < count; ++i) {
+    int found = 0;
+    if (targets[i].kind != AFM_TARGET_COMBINATION) continue;
+    for (j = 0; j < count && !found; ++j)
+      found = targets[j].kind == AFM_TARGET_FAP && targets[j].number == targets[i].number &&
+              targets[j].reference == targets[i].reference;
+    if (!found)
+      return afm_fail(&r, AFM_ERR_RANGE,
+                      "target %lu (combination of FAP %u at %ld): no FAP target at that reference",
+                      (unsigned long)i, (unsigned)targets[i].number, (long)targets[i].reference);
+  }
   *count_out = count;
   *targets_out = targets;
   return AFM_OK;
@@ -138,6 +168,12 @@ afm_result afm_targets_encode_to(const afm_target *targets, uint32_t count, afm_
     afm_write_i32(w, t->reference);
     afm_write_u32(w, t->run_count);
     afm_write_u32(w, t->delta_count);
+    if (t->kind == AFM_TARGET_COMBINATION) {
+      afm_write_u8(w, t->gate);
+      afm_write_u8(w, 0);
+      afm_write_u16(w, 0);
+      afm_write_i32(w, t->gate_reference);
+    }
     for (k = 0; k < t->run_count; ++k) {
       afm_write_u32(w, t->runs[k].start);
       afm_write_u32(w, t->runs[k].length);

@@ -24,11 +24,14 @@ static void usage(FILE *out) {
 }
 
 static const char *target_kind(uint8_t k) {
-  return k == AFM_TARGET_FAP ? "FAP" : k == AFM_TARGET_VISEME ? "viseme" : "expression";
+  return k == AFM_TARGET_FAP           ? "FAP"
+         : k == AFM_TARGET_VISEME      ? "viseme"
+         : k == AFM_TARGET_COMBINATION ? "comb"
+                                       : "expression";
 }
 
 static const char *target_name(const afm_target *t) {
-  if (t->kind == AFM_TARGET_FAP) {
+  if (t->kind == AFM_TARGET_FAP || t->kind == AFM_TARGET_COMBINATION) {
     const afm_fap_info *f = afm_fap(t->number);
     return f ? f->name : "?";
   }
@@ -120,17 +123,17 @@ static void print_geometry(const afm_doc *d) {
 }
 
 static void print_targets(const afm_doc *d, int list) {
-  uint32_t i, counts[3] = {0, 0, 0};
+  uint32_t i, counts[4] = {0, 0, 0, 0};
   unsigned long deltas = 0, runs = 0;
   for (i = 0; i < d->target_count; ++i) {
-    counts[d->targets[i].kind < 3 ? d->targets[i].kind : 0]++;
+    counts[d->targets[i].kind < 4 ? d->targets[i].kind : 0]++;
     deltas += d->targets[i].delta_count;
     runs += d->targets[i].run_count;
   }
-  printf("morph targets: %lu (%lu FAP, %lu viseme, %lu expression); %lu deltas in %lu runs;"
+  printf("morph targets: %lu (%lu FAP, %lu viseme, %lu expression, %lu combination); %lu deltas in %lu runs;"
          " deltas int16 in position quanta\n",
          (unsigned long)d->target_count, (unsigned long)counts[0], (unsigned long)counts[1],
-         (unsigned long)counts[2], deltas, runs);
+         (unsigned long)counts[2], (unsigned long)counts[3], deltas, runs);
   if (d->lift)
     printf("control points (LIFT): %lu, driving %lu vertices in %lu run(s); target entries from %lu on are "
            "controls\n",
@@ -143,6 +146,9 @@ static void print_targets(const afm_doc *d, int list) {
     printf("  %-10s  %2u  %-28s  %9ld  %5lu  %8lu  %s\n", target_kind(t->kind), t->number,
            target_name(t), (long)t->reference, (unsigned long)t->run_count,
            (unsigned long)t->delta_count, (t->flags & AFM_TARGET_NORMALS) ? "yes" : "no");
+    if (t->kind == AFM_TARGET_COMBINATION)
+      printf("  %-10s  %2s  gated by FAP %u (%s) at %ld\n", "", "", (unsigned)t->gate,
+             afm_fap(t->gate) ? afm_fap(t->gate)->name : "?", (long)t->gate_reference);
   }
 }
 

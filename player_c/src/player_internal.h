@@ -29,7 +29,8 @@ struct afm_player {
   /* weights.c: target lookup (index into doc->targets, or -1). A FAP side's
    * targets form a chain from the reference nearest zero outward. */
   int32_t fap_positive[AFM_FAP_COUNT + 1], fap_negative[AFM_FAP_COUNT + 1];
-  int32_t *next_target;    /* [targets] the same FAP side's next farther target, or -1 */
+  int32_t *next_target;    /* [targets] the same FAP side's next farther target, or -1;
+                              for a combination, the FAP target it follows */
   int32_t viseme[AFM_VISEME_COUNT], expression[AFM_EXPRESSION_COUNT];
   int32_t *max_delta;      /* [targets] largest |delta| component (quanta or Q14) */
   int32_t *weight_scratch; /* [2 targets] */

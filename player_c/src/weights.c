@@ -2,7 +2,9 @@
  * weight = value / reference. With in-betweens (targets at references
  * r1 < r2 < ... on one side, formats/afm.md): piecewise linear, the value
  * blends the two targets around it, and beyond the farthest the last
- * segment extrapolates. */
+ * segment extrapolates. A combination target (since 1.4) takes the weight
+ * of the FAP target it follows, capped by its gate FAP's value / gate
+ * reference, and never below 0. */
 #include "player_internal.h"
 
 /* In 64 bits: -INT32_MIN does not fit 32. */
@@ -39,6 +41,15 @@ void afm_weights_init(afm_player *p) {
       add_lookup(&p->viseme[t->number], (int32_t)i);
     else if (t->kind == AFM_TARGET_EXPRESSION && t->number < AFM_EXPRESSION_COUNT)
       add_lookup(&p->expression[t->number], (int32_t)i);
+    else if (t->kind == AFM_TARGET_COMBINATION) {
+      /* Not in any chain: next_target holds the FAP target it follows
+       * (the reader checked that there is one). */
+      uint32_t j;
+      for (j = 0; j < doc->target_count; ++j)
+        if (doc->targets[j].kind == AFM_TARGET_FAP && doc->targets[j].number == t->number &&
+            doc->targets[j].reference == t->reference)
+          p->next_target[i] = (int32_t)j;
+    }
     for (k = 0; k < t->delta_count; ++k) {
       int32_t d[6];
       int c;
@@ -62,16 +73,18 @@ int32_t afm_lerp_value(int32_t a, int32_t b, afm_q16 t) {
  * target's weight. |numerator| < 2^32 and 4096 = 2^12: the product is below
  * 2^44. Each term is clamped to 2^24 (a weight of 4096, far past the Q12
  * range the kernel saturates to), so a sum of a few stays in 32 bits. */
-static void add_weight(int32_t *w, int32_t target, int64_t numerator, int64_t reference) {
-  int64_t num, den, q;
-  if (target < 0 || numerator == 0 || reference == 0) return;
-  num = numerator * AFM_Q12_ONE;
-  den = reference;
+static int32_t q12_ratio(int64_t numerator, int64_t reference) {
+  int64_t num = numerator * AFM_Q12_ONE, den = reference, q;
   if (den < 0) num = -num, den = -den;
   q = (num >= 0 ? num + den / 2 : num - den / 2) / den; /* C99 division truncates */
   if (q > ((int64_t)1 << 24)) q = (int64_t)1 << 24;
   if (q < -((int64_t)1 << 24)) q = -((int64_t)1 << 24);
-  w[target] += (int32_t)q;
+  return (int32_t)q;
+}
+
+static void add_weight(int32_t *w, int32_t target, int64_t numerator, int64_t reference) {
+  if (target < 0 || numerator == 0 || reference == 0) return;
+  w[target] += q12_ratio(numerator, reference);
 }
 
 /* Q12 weights of one state, summed into w[targets]. */
@@ -110,6 +123,20 @@ static void state_weights(const afm_player *p, const afm_fap_state *s, int32_t *
     add_weight(w, p->expression[s->expression.select1], s->expression.intensity1, 63);
   if (s->expression.select2 < AFM_EXPRESSION_COUNT)
     add_weight(w, p->expression[s->expression.select2], s->expression.intensity2, 63);
+  {
+    /* Combinations, after every FAP target's weight: the followed one's
+     * (a chain weight, |w| <= 2^25 from add_weight's clamp) capped by the
+     * gate's own Q12 ratio; both in 32 bits, min and max exact. */
+    uint32_t i;
+    for (i = 0; i < doc->target_count; ++i) {
+      const afm_target *t = &doc->targets[i];
+      int32_t follow = p->next_target[i], gate, c;
+      if (t->kind != AFM_TARGET_COMBINATION || follow < 0 || t->gate > AFM_FAP_COUNT) continue;
+      gate = s->value[t->gate] ? q12_ratio(s->value[t->gate], t->gate_reference) : 0;
+      c = w[follow] < gate ? w[follow] : gate;
+      if (c > 0) w[i] += c;
+    }
+  }
 }
 
 int64_t afm_pose_weights(afm_player *p, const afm_fap_state *a, const afm_fap_state *b, afm_q16 t) {

@@ -15,7 +15,8 @@
  *     the bump moved 0.1 FAPU-distance along the FAP's direction; normal
  *     deltas on even FAPs; a negative-side target (reference -256, another
  *     shape) on every third bidirectional FAP; an in-between at 640 (the
- *     bump further along and turned) on every fourth FAP;
+ *     bump further along and turned) on every fourth FAP, and on every
+ *     other of those a combination at 640 gated by FAP 3 at 512;
  *   - visemes 1..14 and expressions 1..6 (reference 63): mixes of bumps around
  *     the lips, mouth corners and eyebrows.
  * --lift: the targets move control points instead (formats/afm.md, LIFT):
@@ -199,6 +200,21 @@ static void fap_targets(synth *s) {
       clear(s);
       bump(s, c, 0.4 * s->es0_q, 2, d, n);
       emit(s, AFM_TARGET_FAP, f, 640, f % 8 == 0);
+      if (f % 8 == 4 && s->targets[s->target_count - 1].number == f) {
+        /* A combination on it (version 1.4), gated by the jaw's opening
+         * (FAP 3 at 512): the bump across, with normal deltas. */
+        for (k = 0; k < 3; ++k) {
+          d[k] = -0.8 * amp * info->direction[(k + 1) % 3];
+          n[k] = 1200.0 * info->direction[k];
+        }
+        clear(s);
+        bump(s, c, 0.3 * s->es0_q, 2, d, n);
+        emit(s, AFM_TARGET_COMBINATION, f, 640, 1);
+        if (s->targets[s->target_count - 1].kind == AFM_TARGET_COMBINATION) {
+          s->targets[s->target_count - 1].gate = 3;
+          s->targets[s->target_count - 1].gate_reference = 512;
+        }
+      }
     }
   }
 }

@@ -212,6 +212,11 @@ const afm_doc *make_synthetic_doc(SyntheticDoc &s, const SyntheticOptions &o) {
     add_target(s, AFM_TARGET_FAP, 12, 1800, false, brow_field, entries);
     add_target(s, AFM_TARGET_FAP, 12, 1024, normal_deltas, jaw_field, entries);
     add_target(s, AFM_TARGET_FAP, 31, -700, false, jaw_field, entries);
+    if (o.combination) {
+      add_target(s, AFM_TARGET_COMBINATION, 31, -700, false, brow_field, entries);
+      s.targets.back().gate = 3;
+      s.targets.back().gate_reference = 1024;
+    }
   }
   for (size_t i = 0; i < s.targets.size(); ++i) {
     SyntheticDoc::Target &t = s.target_data[i];
@@ -345,7 +350,8 @@ std::string compare_docs(const afm_doc &a, const afm_doc &b) {
     const afm_target &x = a.targets[i], &y = b.targets[i];
     size_t n = x.delta_count;
     if (x.kind != y.kind || x.number != y.number || x.flags != y.flags ||
-        x.reference != y.reference || x.run_count != y.run_count || x.delta_count != y.delta_count)
+        x.reference != y.reference || x.gate != y.gate || x.gate_reference != y.gate_reference ||
+        x.run_count != y.run_count || x.delta_count != y.delta_count)
       return "target header " + std::to_string(i);
     for (uint32_t k = 0; k < x.run_count; ++k)
       if (x.runs[k].start != y.runs[k].start || x.runs[k].length != y.runs[k].length)

@@ -54,6 +54,9 @@ struct SyntheticOptions {
   // eye's yaw (23) and pitch (25) bent at knots (version 1.3): half as
   // steep past 20000, twice as steep below -15000.
   bool in_betweens = false;
+  // With in_betweens, a combination (version 1.4) on FAP 31's target at
+  // -700, gated by FAP 3 at 1024, with a field of its own.
+  bool combination = false;
 };
 
 // Fills `s` and returns &s.doc (valid while `s` lives and is not moved).

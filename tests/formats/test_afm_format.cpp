@@ -154,7 +154,7 @@ TEST(AfmFormat, RawAndDracoConvertExactly) {
     afmtest::SyntheticOptions o;
     o.normals = o.texcoords = o.colors = o.normal_deltas = attrs;
     o.loose_vertex = variant == 2;  // edgebreaker drops it: it travels beside the stream
-    o.in_betweens = variant == 0;
+    o.in_betweens = o.combination = variant == 0;
     o.rows = 60, o.cols = 80;
     const afm_doc *src = make_synthetic_doc(s, o);
     std::vector<uint8_t> raw = write_doc(*src, AFM_PROFILE_RAW);
@@ -450,6 +450,58 @@ TEST(AfmFormat, LiftRulesAreEnforced) {
   afm_diag diag{};
   EXPECT_EQ(read(f, &doc, &diag), AFM_ERR_RANGE);
   EXPECT_EQ(diag.chunk, AFM_CHUNK_LIFT) << diag.message;
+}
+
+// A combination target (version 1.4) names a gate FAP other than its own
+// and a gate reference, and follows a FAP target the file holds at its
+// number and reference; its gate's padding is zero.
+TEST(AfmFormat, CombinationRulesAreEnforced) {
+  afmtest::SyntheticOptions o;
+  o.in_betweens = o.combination = true;
+  SyntheticDoc good;
+  make_synthetic_doc(good, o);
+  ASSERT_EQ(good.targets.back().kind, AFM_TARGET_COMBINATION);
+  DocPtr doc;
+  ASSERT_EQ(read(write_doc(good.doc, AFM_PROFILE_RAW), &doc), AFM_OK);
+  EXPECT_EQ(compare_docs(good.doc, *doc), "");
+  const SpoilCase cases[] = {
+      {"gated by itself", [](SyntheticDoc &s) { s.targets.back().gate = 31; }, "gate FAP 31"},
+      {"gate below FAP 3", [](SyntheticDoc &s) { s.targets.back().gate = 2; }, "gate FAP 2"},
+      {"gate past FAP 68", [](SyntheticDoc &s) { s.targets.back().gate = 69; }, "gate FAP 69"},
+      {"gate reference 0", [](SyntheticDoc &s) { s.targets.back().gate_reference = 0; }, "at 0"},
+      {"no target at its reference", [](SyntheticDoc &s) { s.targets.back().reference = -701; },
+       "no FAP target at that reference"},
+      {"twice", [](SyntheticDoc &s) {
+         s.targets.push_back(s.targets.back());
+         s.doc.targets = s.targets.data();
+         s.doc.target_count = uint32_t(s.targets.size());
+       },
+       "appears twice"},
+  };
+  expect_writer_refuses(cases, sizeof cases / sizeof cases[0], o);
+  // The reader refuses the gate's padding not zero, CRCs resealed: the last
+  // target's header ends with u8 gate, u8 0, u16 0, i32 gate_reference.
+  SyntheticDoc s;
+  std::vector<uint8_t> f = write_doc(*make_synthetic_doc(s, o), AFM_PROFILE_RAW);
+  afm_container c;
+  ASSERT_EQ(afm_container_open(f.data(), f.size(), &c, nullptr), AFM_OK);
+  const afm_target &last = s.targets.back();
+  const size_t tail = 8 * size_t(last.run_count) + 3 * ((2 * size_t(last.delta_count) + 3) / 4 * 4);
+  bool found = false;
+  for (uint32_t i = 0; i < c.chunk_count; ++i) {
+    afm_chunk_info ch;
+    afm_container_chunk(&c, i, &ch);
+    if (ch.kind != AFM_CHUNK_MTGT) continue;
+    const size_t gate = ch.offset + ch.length - tail - 8;  // the gate's first byte
+    ASSERT_EQ(f[gate], 3) << "the last target's gate is not where expected";
+    f[gate + 1] = 1;
+    reseal_chunk(f, i);
+    found = true;
+  }
+  ASSERT_TRUE(found);
+  afm_diag diag{};
+  EXPECT_EQ(read(f, &doc, &diag), AFM_ERR_RANGE);
+  EXPECT_NE(std::string(diag.message).find("gate's reserved bytes not zero"), std::string::npos) << diag.message;
 }
 
 // afm_target_expand against the LIFT formula evaluated here on the synthetic

@@ -59,6 +59,18 @@ std::vector<double> weights_of(const afm_doc &doc, const Lookup &l, const afm_fa
   add(l.viseme, s.viseme.select2, (63 - s.viseme.blend) / 63.0);
   add(l.expression, s.expression.select1, s.expression.intensity1 / 63.0);
   add(l.expression, s.expression.select2, s.expression.intensity2 / 63.0);
+  // Combinations: the followed FAP target's weight, capped by the gate's
+  // value / gate reference, never below 0.
+  for (uint32_t i = 0; i < doc.target_count; ++i) {
+    const afm_target &t = doc.targets[i];
+    if (t.kind != AFM_TARGET_COMBINATION) continue;
+    for (uint32_t j = 0; j < doc.target_count; ++j) {
+      const afm_target &f = doc.targets[j];
+      if (f.kind != AFM_TARGET_FAP || f.number != t.number || f.reference != t.reference) continue;
+      const double gate = double(s.value[t.gate]) / t.gate_reference;
+      w[i] += std::max(0.0, std::min(w[j], gate));
+    }
+  }
   return w;
 }
 

@@ -497,11 +497,12 @@ struct SyntheticModel {
   std::vector<uint64_t> memory;
   afm_player *player = nullptr;
 
-  explicit SyntheticModel(bool lift = true, bool in_betweens = false) {
+  explicit SyntheticModel(bool lift = true, bool in_betweens = false, bool combination = false) {
     afmtest::SyntheticOptions o;
     o.rows = 40, o.cols = 50;
     o.lift = lift;
     o.in_betweens = in_betweens;
+    o.combination = combination;
     const std::vector<uint8_t> bytes = afmtest::write_doc(*afmtest::make_synthetic_doc(source, o), AFM_PROFILE_RAW);
     afm_doc *d = nullptr;
     EXPECT_EQ(afm_doc_read_alloc(bytes.data(), bytes.size(), nullptr, nullptr, &d), AFM_OK);
@@ -624,10 +625,10 @@ TEST(Player, LiftedGoldenPerFrameHash) {
 
 namespace {
 
-// The Q12 weight of the FAP target at `reference`.
-int weight_at(const SyntheticModel &m, int fap, int32_t reference) {
+// The Q12 weight of the FAP target (or the combination) at `reference`.
+int weight_at(const SyntheticModel &m, int fap, int32_t reference, int kind = AFM_TARGET_FAP) {
   for (uint32_t i = 0; i < m.doc->target_count; ++i)
-    if (m.doc->targets[i].kind == AFM_TARGET_FAP && m.doc->targets[i].number == fap &&
+    if (m.doc->targets[i].kind == kind && m.doc->targets[i].number == fap &&
         m.doc->targets[i].reference == reference)
       return afm_player_weights(m.player)[i];
   ADD_FAILURE() << "no target of FAP " << fap << " at " << reference;
@@ -672,7 +673,9 @@ TEST(Player, InBetweenTargetsBlendPiecewiseLinearly) {
 // target in use: one Q12 unit of weight times its largest delta; plus the
 // output's rounding.
 TEST(Player, InBetweenTargetsMatchTheDoubleModel) {
-  SyntheticModel m(false, true);
+ for (bool combination : {false, true}) {
+  SCOPED_TRACE(combination ? "with a combination" : "in-betweens");
+  SyntheticModel m(false, true, combination);
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   double worst = 0;
@@ -696,7 +699,37 @@ TEST(Player, InBetweenTargetsMatchTheDoubleModel) {
         worst = std::max(worst, e);
       }
   }
-  std::printf("in-between targets, fixed vs double over 30 random poses: worst error %.3f quanta\n", worst);
+  std::printf("%s, fixed vs double over 30 random poses: worst error %.3f quanta\n",
+              combination ? "a combination target" : "in-between targets", worst);
+ }
+}
+
+// A combination target (formats/afm.md, version 1.4) takes the weight of
+// the FAP target it follows (FAP 31 at -700), capped by its gate's value /
+// gate reference (FAP 3 at 1024), never below 0. Exact Q12 values.
+TEST(Player, ACombinationFollowsItsTargetAsFarAsItsGateGoes) {
+  SyntheticModel m(false, true, true);
+  struct Case {
+    int32_t v31, v3;
+    int w700, combination;
+  };
+  const Case cases[] = {
+      {-478, 512, 2048, 2048},    // halfway to -700, the gate halfway: both 1/2
+      {-700, 256, 4096, 1024},    // at -700, the gate at a quarter: the gate's
+      {-700, 2048, 4096, 4096},   // the gate past its reference: the target's
+      {-1144, 1024, 8192, 4096},  // past -700 by its segment, the gate at 1: the gate's
+      {-1144, 3072, 8192, 8192},  // both past: the target's
+      {-700, 0, 4096, 0},         // the gate closed: nothing
+      {-700, -512, 4096, 0},      // the gate negative: nothing, not a negative weight
+      {-256, 1024, 0, 0},         // short of the segment before -700: nothing
+      {256, 1024, 0, 0},          // the other side
+  };
+  for (const Case &c : cases) {
+    const afm_fap_state s = state({{31, c.v31}, {3, c.v3}});
+    ASSERT_EQ(afm_player_pose(m.player, &s, nullptr, 0), AFM_OK);
+    EXPECT_EQ(weight_at(m, 31, -700), c.w700) << c.v31 << " " << c.v3;
+    EXPECT_EQ(weight_at(m, 31, -700, AFM_TARGET_COMBINATION), c.combination) << c.v31 << " " << c.v3;
+  }
 }
 
 // Golden per-frame hashes with in-betweens: the segment choice and its
@@ -707,6 +740,17 @@ TEST(Player, InBetweenGoldenPerFrameHash) {
                                    state({{12, 3000}, {31, -1200}, {3, 400}}), state({{12, -300}, {31, 300}})};
   expect_golden_frames(m, states, 30000,
                        {0x5b18097c2add03a2ull, 0x7dfeb00c08335741ull, 0x7938bfe3781c57ebull, 0xb9b0726dd6640126ull});
+}
+
+// Golden per-frame hashes with a combination: its weight, the followed
+// target's capped by the gate's, pinned. Update with a reason, as
+// GoldenPerFrameHash.
+TEST(Player, CombinationGoldenPerFrameHash) {
+  SyntheticModel m(false, true, true);
+  const afm_fap_state states[4] = {state({{31, -500}, {3, 200}}), state({{31, -900}, {3, 700}}),
+                                   state({{31, -1200}, {3, 1400}, {12, 800}}), state({{31, -700}, {3, -300}})};
+  expect_golden_frames(m, states, 30000,
+                       {0x842f386e6ababeb8ull, 0xe6692ec85913691eull, 0xa607f11d1726c0eaull, 0x31ea78af1b2aaed3ull});
 }
 
 // Control knots (formats/afm.md, RIGD, version 1.3): the synthetic eye's

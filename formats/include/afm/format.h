@@ -88,7 +88,8 @@ void afm_free(const afm_allocator *allocator, void *ptr);
 
 #define AFM_MAGIC_SIZE 8          /* 0x89 'A' 'F' 'M' '\r' '\n' 0x1A '\n' */
 #define AFM_VERSION_MAJOR 1
-#define AFM_VERSION_MINOR 3 /* 1.1 added LIFT, 1.2 in-between targets, 1.3 control knots */
+#define AFM_VERSION_MINOR 4 /* 1.1 added LIFT, 1.2 in-between targets, 1.3 control knots,
+                              1.4 combination targets */
 
 #define AFM_FOURCC(a, b, c, d)                                        \
   ((uint32_t)(uint8_t)(a) | ((uint32_t)(uint8_t)(b) << 8) |           \
@@ -221,7 +222,8 @@ typedef struct afm_geometry {
 typedef enum afm_target_kind {
   AFM_TARGET_FAP = 0,       /* low-level FAP 3..68 */
   AFM_TARGET_VISEME = 1,    /* viseme 1..14 */
-  AFM_TARGET_EXPRESSION = 2 /* expression 1..6 */
+  AFM_TARGET_EXPRESSION = 2, /* expression 1..6 */
+  AFM_TARGET_COMBINATION = 3 /* FAP 3..68, gated by another FAP (since 1.4) */
 } afm_target_kind;
 
 #define AFM_TARGET_NORMALS 0x1u /* target flag: normal deltas present */
@@ -235,12 +237,22 @@ typedef struct afm_run {
  * expressions) minus the neutral face, over the vertices of its runs.
  * weight = value / reference. A target with reference > 0 serves positive
  * values (and negative ones by extrapolation when the FAP has no target of
- * its own with reference < 0). */
+ * its own with reference < 0).
+ *
+ * A combination target (since 1.4) is a correction added on top of other
+ * targets, never a face alone: its weight is
+ *   max(0, min(w, gate value / gate_reference)),
+ * w the weight of the FAP target with the same number and reference (which
+ * the file must hold). The builder stores the lower lip's motion past its
+ * muscles' reach as one, gated by the jaw's opening (FAP 3): the lip goes
+ * on only as far as the jaw carries it (formats/afm.md, MTGT). */
 typedef struct afm_target {
   uint8_t kind;      /* afm_target_kind */
   uint8_t number;    /* FAP, viseme or expression number */
   uint8_t flags;     /* AFM_TARGET_NORMALS */
   int32_t reference; /* != 0 */
+  uint8_t gate;           /* combination targets: the gating FAP 3..68, != number; else 0 */
+  int32_t gate_reference; /* combination targets: the gate's value at weight 1, != 0; else 0 */
   uint32_t run_count;
   const afm_run *runs; /* [run_count] ascending, disjoint */
   uint32_t delta_count; /* N = sum of run lengths */
