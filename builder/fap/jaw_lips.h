@@ -32,19 +32,30 @@
 // Past the lip's reach (fap_synthesis.cpp): the lower lip's muscles take it
 // about 315 FAP units down on Song (5 negative), and a stream may ask for
 // more with the jaw open (Xface's fear.fap: -870, with the jaw at 713). So
-// each of those six FAPs' negative sides gets an in-between at FAP 3's
-// farthest reference R3 (1024): its side's pose (the hold, where it holds)
-// plus alpha x w x G, G the height FAP 3's target at R3 gave up here
-// ((1 - s) times its y motion), w the FAP's share of the skin the lip's
-// FAPs split (fap_partition.h), alpha such that the FDP moves by R3 FAP
-// units. Sent with the jaw, as the streams send them, the lip goes on as the
-// jaw would have carried it; sent alone, it drops in front of the closed
-// teeth, as Candide-3's and Xface's linear FAP blocks take it. The push that
-// kept FAP 3's target at R3 in front of the lower teeth (teeth_clearance.h)
-// goes back the same way, by alpha x w, and the in-between keeps its own
-// clearance over the closed teeth: left in, the push took the generated
+// each of those six FAPs' negative sides gets, at FAP 3's farthest
+// reference R3 (1024), an in-between holding its side's pose (the hold,
+// where it holds), and a combination target (formats/afm.md, AFM 1.4)
+// gated by FAP 3 at R3: E - H, H that pose and
+//
+//     E = (1 - s) H + alpha x w x G   (y; z less alpha x w x the teeth's push),
+//
+// G the height FAP 3's target at R3 gave up here ((1 - s) times its y
+// motion), w the FAP's share of the skin the lip's FAPs split
+// (fap_partition.h), alpha such that the FDP moves by R3 FAP units. Below
+// the lip (s > 0) the side's own motion gives way to the jaw's: taken down
+// by both, the skin above Song's chin went past the chin. The combination's
+// weight is the in-between's, capped by FAP 3's value / R3: sent with the
+// jaw, as the streams send them, the lip goes on as the jaw would have
+// carried it, as far as the jaw opens; sent alone, it holds (until AFM 1.4
+// the in-between was E itself, and alone at -1024 it carried the lip most
+// of the way to the chin, turning 5-19 skin triangles on Song). The push
+// that kept FAP 3's target at R3 in front of the lower teeth
+// (teeth_clearance.h) goes back the same way, by alpha x w, and E keeps its
+// own clearance over the closed teeth: left in, the push took the generated
 // 2,000-vertex head's outer lip 5 points further from Xface's fear.fap
-// (median distance from the prescription).
+// (median distance from the prescription). Played together, FAP 3 at R3
+// and the six sides at -R3 are untangled once, the change shared among the
+// combinations by w (fap_synthesis.cpp).
 //
 // The visemes and expressions are whole poses, the lip's motion included:
 // their jaw carries the lip as before.

@@ -38,8 +38,7 @@
 // that changes it by at most kSliverShare of the edge, it is not fixed (a
 // held one may move: Song's lids at their corners, 0.09-0.18 units, which
 // takes them further off the eyeball), and fewer triangles turn after. What
-// still turns stays turned, for the caller to report (the lower lip's
-// in-betweens at -1024, carried most of the way to the chin). The folds
+// still turns stays turned, for the caller to report. The folds
 // that the split of shared skin made between a FAP's FDP and another FAP's
 // (Song's FAP 57 raises 8.7 3.03 units toward 2.8, which rests 3.35 above
 // it and stays) are evened out in the split's weights before

@@ -8,7 +8,8 @@
 # EachTargetMovesItsFdpByReferenceTimesFapuAlongTheFapsDirection). Song's
 # are checked in test_song.sh. Before the seventy-sixth session the 2k
 # head's worst was 20.5 % (its brows drawn apart), the 10k head's 36.2 %
-# (its outer lower lip lowered). Then no target turns a skin triangle over.
+# (its outer lower lip lowered). Then no target turns a skin triangle over
+# or sinks skin below the skull.
 # Not under the sanitizers: the two whole AFMs with their reports take 17 s
 # here and many minutes there, and the figures are the same.
 test_name=test_fidelity.sh
@@ -34,5 +35,11 @@ for n in 2000 10000; do
     awk -F, 'NR == 1 && $21 != "turned" { print "no turned column: " $0 }
       NR > 1 && $21 > 0 { print $1, $2, "at", $5 ":", $21 }' >"$tmp/turned$n.txt"
   [ -s "$tmp/turned$n.txt" ] && fail "the $n-vertex head: targets turn skin triangles over: $(tr '\n' ';' <"$tmp/turned$n.txt")"
+  # Nor sinks skin below the skull (the report's `sunk`: skull-tied vertices
+  # more than an AFM quantum below their skull node's rest plane).
+  sed 's/"[^"]*"//g' "$tmp/r$n/report.csv" |
+    awk -F, 'NR == 1 && $22 != "sunk" { print "no sunk column: " $0 }
+      NR > 1 && $22 > 0 { print $1, $2, "at", $5 ":", $22 }' >"$tmp/sunk$n.txt"
+  [ -s "$tmp/sunk$n.txt" ] && fail "the $n-vertex head: targets sink skin below the skull: $(tr '\n' ';' <"$tmp/sunk$n.txt")"
 done
 finish

@@ -15,7 +15,9 @@
  *     v / reference; a negative v uses the FAP's negative-side target when the
  *     AFM has one, else extrapolates the positive one. A side with in-betweens
  *     (several targets, formats/afm.md) blends the two around v piecewise
- *     linearly, the last segment extrapolated past the farthest.
+ *     linearly, the last segment extrapolated past the farthest. A
+ *     combination target (AFM 1.4) takes the weight of the target it follows,
+ *     capped by its gate FAP's value / gate reference, never below 0.
  *   - FAP 1: viseme_select1 at blend/63 plus viseme_select2 at (63 - blend)/63.
  *   - FAP 2: expression_select1 at intensity1/63 plus expression_select2 at
  *     intensity2/63. init_face and the def flags are decoded and kept; they do
