@@ -51,6 +51,24 @@ void reseal_chunk(std::vector<uint8_t> &f, uint32_t i) {
   reseal_header(f);
 }
 
+// Calls edit(info) on the file's first chunk of `kind`, whose payload it may
+// change in place (f[info.offset ...]), then reseals its CRC. False when the
+// file does not open or has no such chunk.
+template <class Edit>
+bool edit_chunk(std::vector<uint8_t> &f, uint32_t kind, Edit edit) {
+  afm_container c;
+  if (afm_container_open(f.data(), f.size(), &c, nullptr) != AFM_OK) return false;
+  for (uint32_t i = 0; i < c.chunk_count; ++i) {
+    afm_chunk_info ch;
+    afm_container_chunk(&c, i, &ch);
+    if (ch.kind != kind) continue;
+    edit(ch);
+    reseal_chunk(f, i);
+    return true;
+  }
+  return false;
+}
+
 // Encoding (0 raw, 1 draco) of the chunk of this kind.
 int chunk_encoding(const std::vector<uint8_t> &f, uint32_t kind) {
   afm_container c;
@@ -436,16 +454,10 @@ TEST(AfmFormat, LiftRulesAreEnforced) {
   // place, CRCs resealed.
   SyntheticDoc s;
   std::vector<uint8_t> f = write_doc(*make_synthetic_doc(s, o), AFM_PROFILE_RAW);
-  afm_container c;
-  ASSERT_EQ(afm_container_open(f.data(), f.size(), &c, nullptr), AFM_OK);
-  for (uint32_t i = 0; i < c.chunk_count; ++i) {
-    afm_chunk_info ch;
-    afm_container_chunk(&c, i, &ch);
-    if (ch.kind != AFM_CHUNK_LIFT) continue;
+  ASSERT_TRUE(edit_chunk(f, AFM_CHUNK_LIFT, [&](const afm_chunk_info &ch) {
     const size_t c0 = ch.offset + 12 + 8 * size_t(s.lift.run_count);  // the first c0
     put32(&f[c0], s.lift.control_count + 7);
-    reseal_chunk(f, i);
-  }
+  }));
   DocPtr doc;
   afm_diag diag{};
   EXPECT_EQ(read(f, &doc, &diag), AFM_ERR_RANGE);
@@ -483,22 +495,13 @@ TEST(AfmFormat, CombinationRulesAreEnforced) {
   // target's header ends with u8 gate, u8 0, u16 0, i32 gate_reference.
   SyntheticDoc s;
   std::vector<uint8_t> f = write_doc(*make_synthetic_doc(s, o), AFM_PROFILE_RAW);
-  afm_container c;
-  ASSERT_EQ(afm_container_open(f.data(), f.size(), &c, nullptr), AFM_OK);
   const afm_target &last = s.targets.back();
   const size_t tail = 8 * size_t(last.run_count) + 3 * ((2 * size_t(last.delta_count) + 3) / 4 * 4);
-  bool found = false;
-  for (uint32_t i = 0; i < c.chunk_count; ++i) {
-    afm_chunk_info ch;
-    afm_container_chunk(&c, i, &ch);
-    if (ch.kind != AFM_CHUNK_MTGT) continue;
+  ASSERT_TRUE(edit_chunk(f, AFM_CHUNK_MTGT, [&](const afm_chunk_info &ch) {
     const size_t gate = ch.offset + ch.length - tail - 8;  // the gate's first byte
-    ASSERT_EQ(f[gate], 3) << "the last target's gate is not where expected";
+    EXPECT_EQ(f[gate], 3) << "the last target's gate is not where expected";
     f[gate + 1] = 1;
-    reseal_chunk(f, i);
-    found = true;
-  }
-  ASSERT_TRUE(found);
+  }));
   afm_diag diag{};
   EXPECT_EQ(read(f, &doc, &diag), AFM_ERR_RANGE);
   EXPECT_NE(std::string(diag.message).find("gate's reserved bytes not zero"), std::string::npos) << diag.message;
