@@ -1874,25 +1874,33 @@ void lift_synthesis(FapSynthesis &synthesis, const SimMesh &sim) {
     if (o.kind == AFM_TARGET_VISEME || o.kind == AFM_TARGET_EXPRESSION)
       o.largest = t.displacement[skin].rowwise().norm().maxCoeff();
   }
-  // A combination is judged as played: with every combination of its gate
-  // at the same reference, the targets they follow and the gate's.
+  // A combination is judged as played.
   for (auto [o, c] : combinations) {
-    const MorphTarget &ct = synthesis.targets[c];
     Eigen::MatrixXd played = sim.skin_V;
-    for (const MorphTarget &t : synthesis.targets) {
-      if (skin >= t.displacement.size() || t.displacement[skin].rows() != played.rows()) continue;
-      const bool gate = t.kind == AFM_TARGET_FAP && t.number == ct.gate && t.reference == ct.gate_reference;
-      const bool partner = t.kind == AFM_TARGET_COMBINATION && t.gate == ct.gate &&
-                           t.gate_reference == ct.gate_reference && t.reference == ct.reference;
-      bool followed = false;
-      for (const MorphTarget &u : synthesis.targets)
-        followed |= t.kind == AFM_TARGET_FAP && u.kind == AFM_TARGET_COMBINATION && u.gate == ct.gate &&
-                    u.gate_reference == ct.gate_reference && u.reference == ct.reference &&
-                    t.number == u.number && t.reference == u.reference;
-      if (gate || partner || followed) played += t.displacement[skin];
-    }
+    for (size_t i : played_with(synthesis.targets, c))
+      if (skin < synthesis.targets[i].displacement.size() &&
+          synthesis.targets[i].displacement[skin].rows() == played.rows())
+        played += synthesis.targets[i].displacement[skin];
     o->turned = static_cast<int>(turned_faces(sim.skin_V, sim.skin_F, played).size());
   }
+}
+
+std::vector<size_t> played_with(const std::vector<MorphTarget> &targets, size_t c) {
+  std::vector<size_t> with;
+  if (c >= targets.size() || targets[c].kind != AFM_TARGET_COMBINATION) return with;
+  const MorphTarget &ct = targets[c];
+  auto partner = [&ct](const MorphTarget &u) {
+    return u.kind == AFM_TARGET_COMBINATION && u.gate == ct.gate && u.gate_reference == ct.gate_reference &&
+           u.reference == ct.reference;
+  };
+  for (size_t i = 0; i < targets.size(); ++i) {
+    const MorphTarget &t = targets[i];
+    bool in = partner(t) || (t.kind == AFM_TARGET_FAP && t.number == ct.gate && t.reference == ct.gate_reference);
+    for (const MorphTarget &u : targets)
+      in |= partner(u) && t.kind == AFM_TARGET_FAP && t.number == u.number && t.reference == u.reference;
+    if (in) with.push_back(i);
+  }
+  return with;
 }
 
 AfmContent fap_afm_content(const Scene &scene, const FdpSet &fdps, const FaceModel &model, FapSynthesis synthesis) {

@@ -351,13 +351,22 @@ constexpr double kModiolusRadius = 0.13;
 // as above. Nothing changes for radius <= 0 or a corner out of range.
 void move_modiolus(const Eigen::MatrixXd &V0, int corner, double radius, Eigen::MatrixXd &D);
 
+// The targets a combination target plays with, as a stream that asks for
+// it sends them (fap_synthesis.cpp judges and the report draws it so):
+// every combination of its gate at its gate reference and reference (itself
+// included), the FAP targets they follow, and the gate's target at its
+// reference. Indices into `targets`; empty when targets[c] is no
+// combination.
+std::vector<size_t> played_with(const std::vector<MorphTarget> &targets, size_t c);
+
 // Carries a synthesis made on a simulation mesh (sim_mesh.h: the model built
 // on sim_scene) to the skin. synthesize_faps does it when given the mesh
 // (FapSynthesisOptions::sim), and only then is the lifted skin checked for
 // folds: called on a synthesis made without it, the lift is blind to them.
 // What it does: every target's skin displacement becomes #V x 3
 // over the skin's own vertices, and the `largest` of each viseme and
-// expression is measured there. The simulation mesh's displacement becomes
+// expression and the `turned` of each target are measured there (a
+// combination's as played_with says). The simulation mesh's displacement becomes
 // the target's `controls`, and `lift` binds the skin and the carried parts
 // to them (formats/afm.md, LIFT). Nothing changes when the simulation mesh
 // is the skin, or on a synthesis already lifted.

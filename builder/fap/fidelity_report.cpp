@@ -53,7 +53,7 @@ std::string target_id(const FapOutcome &o) {
 std::string file_stem(const FapOutcome &o) {
   if (o.kind == AFM_TARGET_VISEME) return format("viseme%02d", o.number);
   if (o.kind == AFM_TARGET_EXPRESSION) return format("expression%d", o.number);
-  if (o.kind == AFM_TARGET_COMBINATION)
+  if (o.kind == AFM_TARGET_COMBINATION)  // the builder gates its combinations by FAP 3 only
     return format("fap%02d%s-%d-with-fap03", o.number, o.side < 0 ? "-neg" : "", std::abs(o.reference));
   if (o.in_between) return format("fap%02d%s-%d", o.number, o.side < 0 ? "-neg" : "", std::abs(o.reference));
   return format("fap%02d%s", o.number, o.side < 0 ? "-neg" : "");
@@ -346,20 +346,12 @@ Status write_fidelity_report(const std::string &dir, const Scene &scene, const F
     if (!o.made) continue;
     const MorphTarget &t = s.targets[next++];
     Scene posed = scene;
-    // A combination as played and judged (lift_synthesis): with the other
-    // combinations of its gate at its reference, the targets they follow
-    // and the gate's.
+    // A combination as played and judged (played_with).
     std::vector<const MorphTarget *> shown = {&t};
-    if (t.kind == AFM_TARGET_COMBINATION)
-      for (const MorphTarget &u : s.targets) {
-        bool with = u.kind == AFM_TARGET_FAP && u.number == t.gate && u.reference == t.gate_reference;
-        for (const MorphTarget &c : s.targets)
-          if (c.kind == AFM_TARGET_COMBINATION && c.gate == t.gate && c.gate_reference == t.gate_reference &&
-              c.reference == t.reference)
-            with |= (&u == &c && &u != &t) ||
-                    (u.kind == AFM_TARGET_FAP && u.number == c.number && u.reference == c.reference);
-        if (with) shown.push_back(&u);
-      }
+    if (t.kind == AFM_TARGET_COMBINATION) {
+      shown.clear();
+      for (size_t i : played_with(s.targets, next - 1)) shown.push_back(&s.targets[i]);
+    }
     const Eigen::Affine3d jaw = t.kind == AFM_TARGET_COMBINATION ? jaw_at(s, t.gate, t.gate_reference)
                                 : o.kind == AFM_TARGET_FAP       ? jaw_at(s, o.number, o.reference)
                                                                  : Eigen::Affine3d::Identity();

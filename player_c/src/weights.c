@@ -131,7 +131,8 @@ static void state_weights(const afm_player *p, const afm_fap_state *s, int32_t *
     for (i = 0; i < doc->target_count; ++i) {
       const afm_target *t = &doc->targets[i];
       int32_t follow = p->next_target[i], gate, c;
-      if (t->kind != AFM_TARGET_COMBINATION || follow < 0 || t->gate > AFM_FAP_COUNT) continue;
+      if (t->kind != AFM_TARGET_COMBINATION) continue;
+      if (follow < 0 || t->gate > AFM_FAP_COUNT || t->gate_reference == 0) continue; /* not from the reader */
       gate = s->value[t->gate] ? q12_ratio(s->value[t->gate], t->gate_reference) : 0;
       c = w[follow] < gate ? w[follow] : gate;
       if (c > 0) w[i] += c;
