@@ -1905,7 +1905,7 @@ TEST(FapSynthesis, ASteeredPoseFromTheRangesEndMeetsTheOneFromRest) {
 TEST(FapSynthesis, TheSameOnAnyNumberOfThreads) {
   const Built &b = head_1k();
   FapSynthesisOptions o;
-  o.only = {3, 12, 33};
+  o.only = {3, 5, 12, 33};  // 5: the lower lip's hold and combination past its reach, with the jaw's
   o.only_visemes = {10};
   o.threads = 1;
   Expected<FapSynthesis> one = synthesize_faps(b.head.scene, b.model, o);
@@ -1917,9 +1917,13 @@ TEST(FapSynthesis, TheSameOnAnyNumberOfThreads) {
     EXPECT_EQ(one->targets[i].kind, three->targets[i].kind);
     EXPECT_EQ(one->targets[i].number, three->targets[i].number);
     EXPECT_EQ(one->targets[i].reference, three->targets[i].reference);
+    EXPECT_EQ(one->targets[i].gate, three->targets[i].gate);
     const size_t skin = static_cast<size_t>(b.model.skin);
     EXPECT_EQ(one->targets[i].displacement[skin], three->targets[i].displacement[skin]) << "bit for bit";
   }
+  int combinations = 0;
+  for (const MorphTarget &t : one->targets) combinations += t.kind == AFM_TARGET_COMBINATION;
+  EXPECT_EQ(combinations, 1) << "FAP 5's past its reach";
   ASSERT_EQ(one->jaw.controls.size(), three->jaw.controls.size());
   for (size_t i = 0; i < one->jaw.controls.size(); ++i) EXPECT_EQ(one->jaw.controls[i].gain, three->jaw.controls[i].gain);
 }
