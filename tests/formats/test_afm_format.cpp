@@ -340,6 +340,7 @@ TEST(AfmFormat, DamagedDracoStreamsFailCleanly) {
   afmtest::SyntheticOptions o;
   o.rows = 30, o.cols = 40;
   o.lift = lift;
+  o.in_betweens = o.combination = !lift;  // a combination's gate in the MTGT headers
   std::vector<uint8_t> good = write_doc(*make_synthetic_doc(s, o), AFM_PROFILE_DRACO);
   afm_container c;
   ASSERT_EQ(afm_container_open(good.data(), good.size(), &c, nullptr), AFM_OK);
