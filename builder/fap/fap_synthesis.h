@@ -248,9 +248,9 @@ struct FapOutcome {
 // Whether a made outcome is a FAP target the face model solved (muscles,
 // jaw, lids): the ones the fidelity figures summarise. The tongue's and the
 // pupils' (kinematic_fap) and the lower lip's holds and combinations past
-// its reach (from_jaw) are exact by construction (with the jaw), a lip corner held past its
-// reference (past_reference) stores its reference's pose, and visemes and
-// expressions have no FDP rule.
+// its reach (from_jaw) are exact by construction (with the jaw), a lip
+// corner held past its reference (past_reference) stores its reference's
+// pose, and visemes and expressions have no FDP rule.
 bool solved_fap_target(const FapOutcome &o);
 
 // Whether a made outcome's pose is its own solve, counted once where a
@@ -363,13 +363,13 @@ std::vector<size_t> played_with(const std::vector<MorphTarget> &targets, size_t 
 // on sim_scene) to the skin. synthesize_faps does it when given the mesh
 // (FapSynthesisOptions::sim), and only then is the lifted skin checked for
 // folds: called on a synthesis made without it, the lift is blind to them.
-// What it does: every target's skin displacement becomes #V x 3
-// over the skin's own vertices, and the `largest` of each viseme and
-// expression and the `turned` of each target are measured there (a
-// combination's as played_with says). The simulation mesh's displacement becomes
-// the target's `controls`, and `lift` binds the skin and the carried parts
-// to them (formats/afm.md, LIFT). Nothing changes when the simulation mesh
-// is the skin, or on a synthesis already lifted.
+// What it does: every target's skin displacement becomes #V x 3 over the
+// skin's own vertices, and the `largest` of each viseme and expression and
+// the `turned` of each target are measured there (a combination's as
+// played_with says). The simulation mesh's displacement becomes the
+// target's `controls`, and `lift` binds the skin and the carried parts to
+// them (formats/afm.md, LIFT). Nothing changes when the simulation mesh is
+// the skin, or on a synthesis already lifted.
 void lift_synthesis(FapSynthesis &synthesis, const SimMesh &sim);
 
 // The AFM's content: the scene, its input FDPs (bound to `scene`; not the
