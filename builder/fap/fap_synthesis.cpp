@@ -1629,7 +1629,8 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     // combination add up to with the jaw open as far. Below the lip the
     // side's own motion gives way to the jaw's as the share FAP 3 keeps
     // there (s) grows: taken down by both, the skin above Song's chin went
-    // past the chin (2 triangles turned, played with the jaw at 1024).
+    // past the chin (4 triangles turned, played with the jaw at 1024; 2
+    // with this, none once the played pose is untangled, below).
     Eigen::MatrixXd E = D.array().colwise() * (1 - lip_kept.array());
     E.col(1) += alpha * G;
     // The push over the teeth that FAP 3's target made goes with the hold;
