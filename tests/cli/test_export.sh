@@ -99,6 +99,32 @@ grep -q ": 0 errors," "$tmp/validate_anat.txt" ||
   fail "the validator reports errors on an anatomical AFM: $(head -n 3 "$tmp/validate_anat.txt")"
 node "$js/validate.cjs" "$tmp/obj/neutral.obj" >"$tmp/validate_bad.txt" 2>&1 &&
   fail "the validator accepts an OBJ file as glTF"
+# A combination target (AFM 1.4): FAP 5's lower lip past its reach, gated by
+# the jaw (FAP 3 at 1024). At key 1 the lip asks -1024 with the jaw at 512:
+# the hold's weight is 1, the combination's min(1, 512 / 1024) = 0.5.
+"$bin/afm-build" "$tmp/head.wrl" "$tmp/head.fdp" -q -o "$tmp/lip.afm" --faps 3,5 >"$tmp/lip.txt" 2>&1 ||
+  fail "afm-build --faps 3,5 failed: $(tail -n 3 "$tmp/lip.txt")"
+{
+  printf '2.1 lip 25 2\n'
+  for key in '0 0 0' '1 512 -1024'; do
+    awk 'BEGIN { for (f = 1; f <= 68; ++f) printf "%s%d", (f > 1 ? " " : ""), (f == 3 || f == 5); print "" }'
+    echo "$key"
+  done
+} >"$tmp/lip.fap"
+"$export_tool" "$tmp/lip.afm" --gltf "$tmp/lip.glb" --fap "$tmp/lip.fap" --vrml "$tmp/lip_afm.wrl" --quiet ||
+  fail "the combination's export failed"
+node "$js/validate.cjs" "$tmp/lip.glb" >"$tmp/validate_lip.txt" 2>&1 || fail "validator: $(cat "$tmp/validate_lip.txt")"
+grep -q ": 0 errors," "$tmp/validate_lip.txt" ||
+  fail "the validator reports errors with a combination: $(head -n 3 "$tmp/validate_lip.txt")"
+node "$js/inspect.cjs" "$tmp/lip.glb" >"$tmp/inspect_lip.txt" 2>&1 || fail "inspect: $(cat "$tmp/inspect_lip.txt")"
+awk '$1 == "weight" && $4 == 1 { w[$3] = $5 }
+  END {
+    c = w["raise_b_midlip_neg_1024_with_open_jaw"]; h = w["raise_b_midlip_neg_1024"]
+    if (c == "" || c < 0.499 || c > 0.501 || h == "" || h < 0.999 || h > 1.001) {
+      printf "key 1: the combination weighs %s (expected 0.5), the hold %s (expected 1)\n", c, h; exit 1 }
+  }' "$tmp/inspect_lip.txt" >"$tmp/weights_lip.txt" || fail "$(cat "$tmp/weights_lip.txt")"
+grep -q '"target raise_b_midlip_neg_1024_with_open_jaw combination 5 reference -1024 gate 3 gate_reference 1024 parts' \
+  "$tmp/lip_afm.wrl" || fail "the VRML file's WorldInfo does not give the combination's gate"
 
 # --- what the file holds
 node "$js/inspect.cjs" "$tmp/head.glb" >"$tmp/inspect.txt" 2>&1 || fail "inspect: $(cat "$tmp/inspect.txt")"
