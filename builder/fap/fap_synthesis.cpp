@@ -1511,6 +1511,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
   // lower lip's FAPs go on with it.
   Eigen::VectorXd lip_given_up, lip_pushed, lip_kept;
   int given_up_at = 0;
+  size_t given_up_by = results.size();  // the work item of FAP 3's target at given_up_at
   std::optional<TeethClearance> teeth;
   {
     const JawLipHold hold = jaw_lip_hold(model);
@@ -1522,6 +1523,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
       if (D.rows() != skin.n) continue;
       if (work[k].reference > given_up_at) {
         given_up_at = work[k].reference;
+        given_up_by = k;
         lip_given_up = D.col(1).cwiseProduct((1 - hold.share.array()).matrix());
         lip_kept = hold.share;
       }
@@ -1668,7 +1670,7 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
     ct.gate_reference = given_up_at;
     for (Eigen::MatrixXd &d : ct.displacement) d = Eigen::MatrixXd();
     ct.displacement[static_cast<size_t>(model.skin)] = E - D;
-    carry(E - D, ct);
+    carry(ct.displacement[static_cast<size_t>(model.skin)], ct);
     co.reference = ct.reference;
     co.in_between = co.from_jaw = true;
     co.holds = co.at_reach = false;
@@ -1726,14 +1728,12 @@ Expected<FapSynthesis> synthesize_faps(const Scene &scene, const FaceModel &mode
   {
     const size_t s0 = static_cast<size_t>(model.skin);
     std::vector<size_t> lips;
-    const MorphTarget *jaw = nullptr;  // FAP 3's target at given_up_at, untangled as stored
-    for (size_t k = 0; k < results.size(); ++k) {
+    for (size_t k = 0; k < results.size(); ++k)
       if (finished[k].far.size() == 2) lips.push_back(k);
-      if (work[k].fap && work[k].fap->driver == FapDriver::JawOpen && work[k].reference == given_up_at &&
-          results[k].target && results[k].target->displacement[s0].rows() == skin.n)
-        jaw = &*results[k].target;
-    }
-    if (!lips.empty() && jaw) {
+    // FAP 3's target at given_up_at, untangled as stored (there are lips
+    // only where it gave up some height).
+    const MorphTarget *jaw = lips.empty() ? nullptr : &*results[given_up_by].target;
+    if (jaw) {
       auto share = [&](size_t k) -> Eigen::VectorXd {
         return skin_share[k].size() == skin.n ? skin_share[k] : Eigen::VectorXd::Ones(skin.n);
       };
@@ -1870,8 +1870,10 @@ void lift_synthesis(FapSynthesis &synthesis, const SimMesh &sim) {
     if (skin >= t.displacement.size() || t.displacement[skin].rows() == 0) continue;
     t.controls = t.displacement[skin];
     t.displacement[skin] = lift_displacement(sim, t.controls);
-    if (t.kind == AFM_TARGET_COMBINATION) combinations.emplace_back(&o, next - 1);
-    o.turned = static_cast<int>(turned_faces(sim.skin_V, sim.skin_F, sim.skin_V + t.displacement[skin]).size());
+    if (t.kind == AFM_TARGET_COMBINATION)
+      combinations.emplace_back(&o, next - 1);  // judged below, once every target is lifted
+    else
+      o.turned = static_cast<int>(turned_faces(sim.skin_V, sim.skin_F, sim.skin_V + t.displacement[skin]).size());
     if (o.kind == AFM_TARGET_VISEME || o.kind == AFM_TARGET_EXPRESSION)
       o.largest = t.displacement[skin].rowwise().norm().maxCoeff();
   }
